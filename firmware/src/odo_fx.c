@@ -1,0 +1,95 @@
+/// Wide integer helpers of odo_fx.h (the trigonometry lives in odo_trig.c).
+/// Written with 32x32->64 partial products only, so the same code is exact on a Cortex-M4
+/// (UMULL) and on a 64-bit host, and never relies on a compiler's __int128.
+#include "odo/odo_fx.h"
+
+#define LO32(v) ((v) & 0xFFFFFFFFULL)
+
+odo_u128_t odo_mul_u64(uint64_t a, uint64_t b)
+{
+    const uint64_t a0 = LO32(a), a1 = a >> 32;
+    const uint64_t b0 = LO32(b), b1 = b >> 32;
+    const uint64_t p00 = a0 * b0, p01 = a0 * b1, p10 = a1 * b0, p11 = a1 * b1;
+    /* Middle column: at most 3 * (2^32 - 1) < 2^34, so it cannot overflow. */
+    const uint64_t mid = (p00 >> 32) + LO32(p01) + LO32(p10);
+    odo_u128_t r;
+    r.lo = (mid << 32) | LO32(p00);
+    r.hi = p11 + (p01 >> 32) + (p10 >> 32) + (mid >> 32);
+    return r;
+}
+
+bool odo_div_u128(odo_u128_t n, uint64_t d, uint64_t *q)
+{
+    if (d == 0U || n.hi >= d) {
+        return false; /* division by zero, or a quotient of 2^64 or more */
+    }
+    /* Restoring division, one quotient bit per iteration. The running remainder is below d,
+     * so after a shift it needs 65 bits: the bit shifted out is kept in `carry`. */
+    uint64_t r = n.hi;
+    uint64_t quo = 0U;
+    for (int i = 63; i >= 0; --i) {
+        const uint64_t carry = r >> 63;
+        r = (r << 1) | ((n.lo >> (unsigned)i) & 1U);
+        quo <<= 1;
+        if (carry != 0U || r >= d) {
+            r -= d;
+            quo |= 1U;
+        }
+    }
+    if (r >= d - r) { /* remainder >= d/2: round half up */
+        if (quo == UINT64_MAX) {
+            return false;
+        }
+        ++quo;
+    }
+    *q = quo;
+    return true;
+}
+
+bool odo_muldiv_u64(uint64_t a, uint64_t b, uint64_t d, uint64_t *out)
+{
+    return odo_div_u128(odo_mul_u64(a, b), d, out);
+}
+
+/// Magnitude of a signed value as unsigned; exact for INT64_MIN.
+static uint64_t mag_s64(int64_t v)
+{
+    return v < 0 ? (uint64_t)0U - (uint64_t)v : (uint64_t)v;
+}
+
+/// Apply a sign to a magnitude known to fit (mag <= 2^63, and 2^63 only when negative).
+static int64_t apply_sign(uint64_t mag, bool negative)
+{
+    if (!negative) {
+        return (int64_t)mag;
+    }
+    return (mag == 0U) ? 0 : -(int64_t)(mag - 1U) - 1;
+}
+
+int64_t odo_mul_s64_s32_shr(int64_t a, int32_t b, unsigned shift)
+{
+    const bool negative = (a < 0) != (b < 0);
+    const uint64_t ua = mag_s64(a);
+    const uint64_t ub = (uint64_t)mag_s64((int64_t)b); /* < 2^32 */
+    /* 96-bit product |a| * |b| = (hi32 : lo64). */
+    const uint64_t p_lo = LO32(ua) * ub;
+    const uint64_t p_hi = (ua >> 32) * ub;
+    uint64_t lo = p_lo + (p_hi << 32);
+    uint64_t hi = (p_hi >> 32) + (lo < p_lo ? 1U : 0U);
+    /* Round half away from zero on the magnitude, then shift the 96-bit value. */
+    const uint64_t half = (uint64_t)1U << (shift - 1U);
+    const uint64_t lo2 = lo + half;
+    hi += (lo2 < lo) ? 1U : 0U;
+    lo = lo2;
+    const uint64_t mag = (shift >= 64U) ? (hi >> (shift - 64U))
+                                        : ((lo >> shift) | (hi << (64U - shift)));
+    return apply_sign(mag, negative);
+}
+
+int64_t odo_shr_round_s64(int64_t v, unsigned shift)
+{
+    const uint64_t mag = mag_s64(v);
+    const uint64_t half = (uint64_t)1U << (shift - 1U);
+    /* mag + half cannot wrap: mag <= 2^63 and half <= 2^61. */
+    return apply_sign((mag + half) >> shift, v < 0);
+}

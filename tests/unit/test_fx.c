@@ -1,0 +1,123 @@
+/// Wide-integer helpers of odo_fx.h: exact products, rounded quotients, rounding shifts, checked
+/// against 128-bit host arithmetic where the compiler has it (on a 32-bit target those comparisons
+/// are skipped and the identity checks still run).
+#include <stdint.h>
+
+#include "odo/odo_fx.h"
+#include "test_support.h"
+#include "unity.h"
+
+void setUp(void) {}
+void tearDown(void) {}
+
+static ts_rng_t rng;
+
+/// A random value whose magnitude spans every bit length, so carries in every column are hit.
+static uint64_t spread_u64(void)
+{
+    const unsigned bits = (unsigned)(ts_rng_u64(&rng) % 65U);
+    if (bits == 0U) {
+        return 0U;
+    }
+    const uint64_t v = ts_rng_u64(&rng);
+    return bits == 64U ? v : (v & ((1ULL << bits) - 1U)) | (1ULL << (bits - 1U));
+}
+
+static void mul_u64_is_the_exact_128_bit_product(void)
+{
+#ifdef __SIZEOF_INT128__
+    const uint64_t edge[] = {0U, 1U, 0xFFFFFFFFU, 0x100000000ULL, UINT64_MAX, UINT64_MAX - 1U};
+    for (unsigned i = 0; i < 6; ++i) {
+        for (unsigned j = 0; j < 6; ++j) {
+            const unsigned __int128 p = (unsigned __int128)edge[i] * edge[j];
+            const odo_u128_t r = odo_mul_u64(edge[i], edge[j]);
+            TEST_ASSERT_EQUAL_HEX64((uint64_t)(p >> 64), r.hi);
+            TEST_ASSERT_EQUAL_HEX64((uint64_t)p, r.lo);
+        }
+    }
+    for (int n = 0; n < 200000; ++n) {
+        const uint64_t a = spread_u64(), b = spread_u64();
+        const unsigned __int128 p = (unsigned __int128)a * b;
+        const odo_u128_t r = odo_mul_u64(a, b);
+        TEST_ASSERT_EQUAL_HEX64((uint64_t)(p >> 64), r.hi);
+        TEST_ASSERT_EQUAL_HEX64((uint64_t)p, r.lo);
+    }
+#else
+    TEST_IGNORE_MESSAGE("no 128-bit reference on this target");
+#endif
+}
+
+static void muldiv_rounds_to_nearest_and_reports_overflow(void)
+{
+    uint64_t q = 0;
+    TEST_ASSERT_TRUE(odo_muldiv_u64(7U, 1U, 2U, &q)); /* 3.5 -> 4 */
+    TEST_ASSERT_EQUAL_UINT64(4U, q);
+    TEST_ASSERT_TRUE(odo_muldiv_u64(5U, 1U, 4U, &q)); /* 1.25 -> 1 */
+    TEST_ASSERT_EQUAL_UINT64(1U, q);
+    TEST_ASSERT_TRUE(odo_muldiv_u64(UINT64_MAX, UINT64_MAX, UINT64_MAX, &q));
+    TEST_ASSERT_EQUAL_UINT64(UINT64_MAX, q);
+    q = 12345U;
+    TEST_ASSERT_FALSE(odo_muldiv_u64(1U, 1U, 0U, &q));          /* division by zero */
+    TEST_ASSERT_FALSE(odo_muldiv_u64(UINT64_MAX, 2U, 1U, &q));  /* quotient >= 2^64 */
+    TEST_ASSERT_FALSE(odo_muldiv_u64(UINT64_MAX, 3U, 2U, &q));  /* rounds up past 2^64 - 1 */
+    TEST_ASSERT_EQUAL_UINT64(12345U, q);                        /* untouched on failure */
+#ifdef __SIZEOF_INT128__
+    for (int n = 0; n < 100000; ++n) {
+        const uint64_t a = spread_u64(), b = spread_u64(), d = spread_u64() | 1U;
+        const unsigned __int128 p = (unsigned __int128)a * b;
+        const unsigned __int128 fl = p / d, rem = p % d;
+        const unsigned __int128 want = fl + (rem >= d - rem ? 1U : 0U);
+        const bool fits = (want >> 64) == 0U;
+        TEST_ASSERT_EQUAL(fits, odo_muldiv_u64(a, b, d, &q));
+        if (fits) {
+            TEST_ASSERT_EQUAL_HEX64((uint64_t)want, q);
+        }
+    }
+#endif
+}
+
+static void mul_s64_s32_shr_is_exact_through_96_bits(void)
+{
+    /* Products far beyond 64 bits whose shifted result fits. */
+    TEST_ASSERT_EQUAL_INT64(INT64_MAX, odo_mul_s64_s32_shr(INT64_MAX, 1 << 30, 30U));
+    TEST_ASSERT_EQUAL_INT64(INT64_MIN, odo_mul_s64_s32_shr(INT64_MIN, 1 << 30, 30U));
+    TEST_ASSERT_EQUAL_INT64(-3, odo_mul_s64_s32_shr(-5, 1, 1U));  /* -2.5 rounds away from zero */
+    TEST_ASSERT_EQUAL_INT64(3, odo_mul_s64_s32_shr(5, 1, 1U));
+    TEST_ASSERT_EQUAL_INT64(-2, odo_mul_s64_s32_shr(-9, 1, 2U));  /* -2.25 -> -2 */
+#ifdef __SIZEOF_INT128__
+    const int64_t ea[] = {INT64_MIN, INT64_MIN + 1, -1, 0, 1, INT64_MAX};
+    const int32_t eb[] = {INT32_MIN, -1, 0, 1, INT32_MAX, 1 << 30};
+    for (int n = 0; n < 300000; ++n) {
+        const int64_t a = n < 36 ? ea[n / 6] : (int64_t)spread_u64();
+        const int32_t b = n < 36 ? eb[n % 6] : (int32_t)(uint32_t)ts_rng_u64(&rng);
+        const unsigned shift = 30U + (unsigned)(ts_rng_u64(&rng) % 33U); /* 30..62 */
+        const __int128 p = (__int128)a * b;
+        const __int128 half = (__int128)1 << (shift - 1U);
+        const __int128 want = p >= 0 ? (p + half) >> shift : -((-p + half) >> shift);
+        if (want > INT64_MAX || want < INT64_MIN) {
+            continue; /* outside the documented domain */
+        }
+        TEST_ASSERT_EQUAL_INT64((int64_t)want, odo_mul_s64_s32_shr(a, b, shift));
+    }
+#endif
+}
+
+static void shr_round_is_symmetric_and_safe_at_the_extremes(void)
+{
+    TEST_ASSERT_EQUAL_INT64(2, odo_shr_round_s64(3, 1U));   /* 1.5 -> 2 */
+    TEST_ASSERT_EQUAL_INT64(-2, odo_shr_round_s64(-3, 1U)); /* -1.5 -> -2 */
+    TEST_ASSERT_EQUAL_INT64(-1, odo_shr_round_s64(-5, 2U)); /* -1.25 -> -1 */
+    TEST_ASSERT_EQUAL_INT64(INT64_MIN / 4, odo_shr_round_s64(INT64_MIN, 2U));
+    TEST_ASSERT_EQUAL_INT64(INT64_MAX / 4 + 1, odo_shr_round_s64(INT64_MAX, 2U));
+}
+
+int main(void)
+{
+    ts_rng_seed(&rng, 0x0D0F00D5EEDULL);
+    UNITY_BEGIN();
+    RUN_TEST(mul_u64_is_the_exact_128_bit_product);
+    RUN_TEST(muldiv_rounds_to_nearest_and_reports_overflow);
+    RUN_TEST(mul_s64_s32_shr_is_exact_through_96_bits);
+    RUN_TEST(shr_round_is_symmetric_and_safe_at_the_extremes);
+    return UNITY_END();
+}
