@@ -1,0 +1,556 @@
+/// odo-params: write and inspect the firmware parameter block (odo/odo_params.h).
+///
+///   odo-params defaults --out FILE   write the 128-byte default block (FILE.tmp, fsync, rename)
+///   odo-params show FILE             decode FILE and print every field as one JSON object
+///
+/// Exit status: 0 success; 1 a rejected block or an I/O error (message on stderr naming the
+/// reason); 2 a usage error. Encoding, decoding and range checks are the firmware's own
+/// (odo_firmware); this file only moves bytes and formats text.
+#define _POSIX_C_SOURCE 200809L
+
+#include <errno.h>
+#include <fcntl.h>
+#include <inttypes.h>
+#include <stdbool.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "odo/odo_params.h"
+
+#define EXIT_REJECTED 1
+#define EXIT_USAGE    2
+
+/// Larger files are not parameter blocks or flash dumps of one; refuse rather than read forever.
+#define MAX_INPUT_BYTES (1024UL * 1024UL)
+
+static const char *const k_prog = "odo-params";
+
+static void usage_main(FILE *f)
+{
+    fprintf(f,
+            "usage: %s <command> [options]\n"
+            "\n"
+            "Write and inspect the odometry firmware parameter block (%u bytes, version %u).\n"
+            "\n"
+            "commands:\n"
+            "  defaults --out FILE   write the default parameter block to FILE\n"
+            "  show FILE             decode FILE, print every field as one JSON object\n"
+            "\n"
+            "Run '%s <command> --help' for a command's options.\n"
+            "Exit status: 0 ok, 1 rejected block or I/O error, 2 usage error.\n",
+            k_prog, ODO_PARAMS_SIZE, ODO_PARAMS_VERSION, k_prog);
+}
+
+static void usage_defaults(FILE *f)
+{
+    fprintf(f,
+            "usage: %s defaults --out FILE\n"
+            "\n"
+            "Write the documented default parameter block (odo_params_defaults) to FILE.\n"
+            "The block is written to FILE.tmp, flushed to disk and renamed over FILE, so FILE is\n"
+            "either the old content or the complete new block; on error nothing is left behind.\n"
+            "\n"
+            "options:\n"
+            "  -o, --out FILE   output file (required)\n"
+            "  -h, --help       show this help\n",
+            k_prog);
+}
+
+static void usage_show(FILE *f)
+{
+    fprintf(f,
+            "usage: %s show FILE\n"
+            "\n"
+            "Decode the parameter block in FILE with the firmware's own decoder (magic, version,\n"
+            "length, CRC-32, ranges) and print every field as one JSON object on stdout, with\n"
+            "\"status\": \"ok\". A rejected block prints a JSON object with the status and reason,\n"
+            "a message on stderr naming the reason (and, for a range error, the field), and exits 1.\n"
+            "\n"
+            "options:\n"
+            "  -h, --help   show this help\n",
+            k_prog);
+}
+
+static bool is_help(const char *a) { return strcmp(a, "-h") == 0 || strcmp(a, "--help") == 0; }
+
+/* ---------------------------------------------------------------------------------------------
+ * defaults
+ * ------------------------------------------------------------------------------------------- */
+static int write_all(int fd, const uint8_t *b, size_t n)
+{
+    while (n > 0) {
+        ssize_t w = write(fd, b, n);
+        if (w < 0) {
+            if (errno == EINTR) {
+                continue;
+            }
+            return -1;
+        }
+        b += (size_t)w;
+        n -= (size_t)w;
+    }
+    return 0;
+}
+
+/// Write b to path atomically: path.tmp, fsync, rename. On failure, no path.tmp remains.
+static int write_file_atomic(const char *path, const uint8_t *b, size_t n)
+{
+    size_t plen = strlen(path);
+    char *tmp = malloc(plen + sizeof ".tmp");
+    if (tmp == NULL) {
+        fprintf(stderr, "%s: out of memory\n", k_prog);
+        return -1;
+    }
+    memcpy(tmp, path, plen);
+    memcpy(tmp + plen, ".tmp", sizeof ".tmp");
+
+    int fd = open(tmp, O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    if (fd < 0) {
+        fprintf(stderr, "%s: cannot create %s: %s\n", k_prog, tmp, strerror(errno));
+        free(tmp);
+        return -1;
+    }
+    const char *step = "write";
+    int rc = write_all(fd, b, n);
+    if (rc == 0) {
+        step = "fsync";
+        rc = fsync(fd);
+    }
+    int saved = errno;
+    if (close(fd) != 0 && rc == 0) {
+        step = "close";
+        rc = -1;
+        saved = errno;
+    }
+    if (rc == 0) {
+        step = "rename";
+        rc = rename(tmp, path);
+        saved = errno;
+    }
+    if (rc != 0) {
+        fprintf(stderr, "%s: cannot %s %s: %s\n", k_prog, step,
+                strcmp(step, "rename") == 0 ? path : tmp, strerror(saved));
+        (void)unlink(tmp);
+    }
+    free(tmp);
+    return rc;
+}
+
+static int cmd_defaults(int argc, char **argv)
+{
+    const char *out = NULL;
+    for (int i = 0; i < argc; i++) {
+        if (is_help(argv[i])) {
+            usage_defaults(stdout);
+            return 0;
+        }
+        if (strcmp(argv[i], "--out") == 0 || strcmp(argv[i], "-o") == 0) {
+            if (i + 1 >= argc) {
+                fprintf(stderr, "%s: defaults: %s needs a file name\n", k_prog, argv[i]);
+                return EXIT_USAGE;
+            }
+            out = argv[++i];
+        } else if (strncmp(argv[i], "--out=", 6) == 0) {
+            out = argv[i] + 6;
+        } else {
+            fprintf(stderr, "%s: defaults: unexpected argument '%s'\n", k_prog, argv[i]);
+            usage_defaults(stderr);
+            return EXIT_USAGE;
+        }
+    }
+    if (out == NULL || out[0] == '\0') {
+        fprintf(stderr, "%s: defaults: --out FILE is required\n", k_prog);
+        usage_defaults(stderr);
+        return EXIT_USAGE;
+    }
+
+    odo_params_t p;
+    uint8_t block[ODO_PARAMS_SIZE];
+    odo_params_defaults(&p);
+    if (odo_params_encode(&p, block, sizeof block) != ODO_PARAMS_SIZE) {
+        fprintf(stderr, "%s: internal error: encoding the defaults failed\n", k_prog);
+        return EXIT_REJECTED;
+    }
+    return write_file_atomic(out, block, sizeof block) == 0 ? 0 : EXIT_REJECTED;
+}
+
+/* ---------------------------------------------------------------------------------------------
+ * show
+ * ------------------------------------------------------------------------------------------- */
+static uint16_t le16(const uint8_t *b) { return (uint16_t)(b[0] | (b[1] << 8)); }
+
+static uint32_t le32(const uint8_t *b)
+{
+    return (uint32_t)b[0] | ((uint32_t)b[1] << 8) | ((uint32_t)b[2] << 16) | ((uint32_t)b[3] << 24);
+}
+
+static int32_t le32s(const uint8_t *b)
+{
+    uint32_t u = le32(b);
+    int32_t s;
+    memcpy(&s, &u, sizeof s);
+    return s;
+}
+
+/// odo_params_decode writes nothing on a range error, so it cannot say which field. To name it,
+/// the block is parsed here from the header's layout table and given to odo_params_validate.
+/// The parse is proved consistent with the firmware encoder on the spot: re-encoding it must give
+/// back the input except at reserved bytes (which encode writes as 0), else this is an internal
+/// error rather than a wrong diagnosis.
+static void parse_unchecked(const uint8_t *b, odo_params_t *p)
+{
+    memset(p, 0, sizeof *p);
+    p->vehicle = b[8];
+    p->counter_bits = b[9];
+    p->heading_form = b[10];
+    p->ipec_mode = b[11];
+    p->tick_us = le32(&b[12]);
+    p->max_wheel_speed_mm_s = le32(&b[16]);
+    for (unsigned t = 0; t < ODO_TRUCKS; t++) {
+        const uint8_t *r = &b[20 + 28 * t];
+        p->truck[t].wheel_diameter_nm = le32(&r[0]);
+        p->truck[t].counts_per_rev_milli = le32(&r[4]);
+        p->truck[t].wheelbase_nm = le32(&r[8]);
+        p->truck[t].ed_q30 = le32s(&r[12]);
+        p->truck[t].eb_q30 = le32s(&r[16]);
+        p->truck[t].es_q30 = le32s(&r[20]);
+        p->truck[t].flags = r[24];
+    }
+    p->link.length_nm = le32(&b[76]);
+    p->link.hitch_offset_nm = le32(&b[80]);
+    p->link.length_bias_nm = le32s(&b[84]);
+    p->link.length_ecc_nm = le32s(&b[88]);
+    p->link.alpha_bias_bam = le32s(&b[92]);
+    p->link.beta_bias_bam = le32s(&b[96]);
+    p->link.rotary_bits = b[100];
+    p->link.stale_ticks = le16(&b[102]);
+    p->link.max_jump_bam = le32(&b[104]);
+    p->link.max_length_jump_um = le32(&b[108]);
+    p->link.length_min_um = le32(&b[112]);
+    p->link.length_max_um = le32(&b[116]);
+}
+
+static bool is_reserved_offset(unsigned off)
+{
+    for (unsigned t = 0; t < ODO_TRUCKS; t++) {
+        unsigned r = 20 + 28 * t + 25;
+        if (off >= r && off < r + 3) {
+            return true;
+        }
+    }
+    return off == 101 || (off >= 120 && off < 124);
+}
+
+static const char *field_name(odo_param_field_t f)
+{
+    switch (f) {
+    case ODO_PF_NONE: return "none";
+    case ODO_PF_VEHICLE: return "vehicle";
+    case ODO_PF_COUNTER_BITS: return "counter_bits";
+    case ODO_PF_HEADING_FORM: return "heading_form";
+    case ODO_PF_IPEC_MODE: return "ipec_mode";
+    case ODO_PF_TICK_US: return "tick_us";
+    case ODO_PF_MAX_WHEEL_SPEED: return "max_wheel_speed_mm_s";
+    case ODO_PF_WHEEL_DIAMETER: return "wheel_diameter_nm";
+    case ODO_PF_COUNTS_PER_REV: return "counts_per_rev_milli";
+    case ODO_PF_WHEELBASE: return "wheelbase_nm";
+    case ODO_PF_ED: return "ed_q30";
+    case ODO_PF_EB: return "eb_q30";
+    case ODO_PF_ES: return "es_q30";
+    case ODO_PF_TRUCK_FLAGS: return "flags";
+    case ODO_PF_LINK_LENGTH: return "link.length_nm";
+    case ODO_PF_HITCH_OFFSET: return "link.hitch_offset_nm";
+    case ODO_PF_LENGTH_BIAS: return "link.length_bias_nm";
+    case ODO_PF_LENGTH_ECC: return "link.length_ecc_nm";
+    case ODO_PF_ALPHA_BIAS: return "link.alpha_bias_bam";
+    case ODO_PF_BETA_BIAS: return "link.beta_bias_bam";
+    case ODO_PF_ROTARY_BITS: return "link.rotary_bits";
+    case ODO_PF_STALE_TICKS: return "link.stale_ticks";
+    case ODO_PF_MAX_JUMP: return "link.max_jump_bam";
+    case ODO_PF_MAX_LENGTH_JUMP: return "link.max_length_jump_um";
+    case ODO_PF_LENGTH_RANGE: return "link.length_min_um/link.length_max_um";
+    case ODO_PF_RESERVED: return "reserved";
+    }
+    return "unknown";
+}
+
+/// The offending value, for the message. Length range: the minimum (the pair is named together).
+static long long field_value(const odo_params_t *p, odo_param_field_t f, unsigned t)
+{
+    const odo_truck_params_t *tr = &p->truck[t < ODO_TRUCKS ? t : 0];
+    switch (f) {
+    case ODO_PF_VEHICLE: return p->vehicle;
+    case ODO_PF_COUNTER_BITS: return p->counter_bits;
+    case ODO_PF_HEADING_FORM: return p->heading_form;
+    case ODO_PF_IPEC_MODE: return p->ipec_mode;
+    case ODO_PF_TICK_US: return p->tick_us;
+    case ODO_PF_MAX_WHEEL_SPEED: return p->max_wheel_speed_mm_s;
+    case ODO_PF_WHEEL_DIAMETER: return tr->wheel_diameter_nm;
+    case ODO_PF_COUNTS_PER_REV: return tr->counts_per_rev_milli;
+    case ODO_PF_WHEELBASE: return tr->wheelbase_nm;
+    case ODO_PF_ED: return tr->ed_q30;
+    case ODO_PF_EB: return tr->eb_q30;
+    case ODO_PF_ES: return tr->es_q30;
+    case ODO_PF_TRUCK_FLAGS: return tr->flags;
+    case ODO_PF_LINK_LENGTH: return p->link.length_nm;
+    case ODO_PF_HITCH_OFFSET: return p->link.hitch_offset_nm;
+    case ODO_PF_LENGTH_BIAS: return p->link.length_bias_nm;
+    case ODO_PF_LENGTH_ECC: return p->link.length_ecc_nm;
+    case ODO_PF_ALPHA_BIAS: return p->link.alpha_bias_bam;
+    case ODO_PF_BETA_BIAS: return p->link.beta_bias_bam;
+    case ODO_PF_ROTARY_BITS: return p->link.rotary_bits;
+    case ODO_PF_STALE_TICKS: return p->link.stale_ticks;
+    case ODO_PF_MAX_JUMP: return p->link.max_jump_bam;
+    case ODO_PF_MAX_LENGTH_JUMP: return p->link.max_length_jump_um;
+    case ODO_PF_LENGTH_RANGE: return p->link.length_min_um;
+    case ODO_PF_NONE:
+    case ODO_PF_RESERVED: break;
+    }
+    return 0;
+}
+
+static bool is_truck_field(odo_param_field_t f) { return f >= ODO_PF_WHEEL_DIAMETER && f <= ODO_PF_TRUCK_FLAGS; }
+
+static const char *status_key(odo_params_status_t s)
+{
+    switch (s) {
+    case ODO_PARAMS_OK: return "ok";
+    case ODO_PARAMS_ERR_SHORT: return "short";
+    case ODO_PARAMS_ERR_MAGIC: return "magic";
+    case ODO_PARAMS_ERR_VERSION: return "version";
+    case ODO_PARAMS_ERR_LENGTH: return "length";
+    case ODO_PARAMS_ERR_CRC: return "crc";
+    case ODO_PARAMS_ERR_RANGE: return "range";
+    case ODO_PARAMS_ERR_ARG: return "arg";
+    }
+    return "unknown";
+}
+
+/// Print s as a JSON string (file names may hold anything).
+static void json_str(FILE *f, const char *s)
+{
+    fputc('"', f);
+    for (const unsigned char *c = (const unsigned char *)s; *c != '\0'; c++) {
+        if (*c == '"' || *c == '\\') {
+            fprintf(f, "\\%c", *c);
+        } else if (*c < 0x20U) {
+            fprintf(f, "\\u%04x", *c);
+        } else {
+            fputc(*c, f);
+        }
+    }
+    fputc('"', f);
+}
+
+static void print_json(FILE *f, const char *path, const uint8_t *b, const odo_params_t *p)
+{
+    fprintf(f, "{\"file\": ");
+    json_str(f, path);
+    fprintf(f, ", \"status\": \"ok\", \"magic\": \"ODOP\", \"version\": %u, \"length\": %u, "
+               "\"crc32\": \"0x%08" PRIX32 "\",\n",
+            (unsigned)le16(&b[4]), (unsigned)le16(&b[6]), le32(&b[ODO_PARAMS_CRC_OFFSET]));
+    fprintf(f, " \"vehicle\": %u, \"counter_bits\": %u, \"heading_form\": %u, \"ipec_mode\": %u, "
+               "\"tick_us\": %" PRIu32 ", \"max_wheel_speed_mm_s\": %" PRIu32 ",\n",
+            p->vehicle, p->counter_bits, p->heading_form, p->ipec_mode, p->tick_us,
+            p->max_wheel_speed_mm_s);
+    fprintf(f, " \"truck\": [");
+    for (unsigned t = 0; t < ODO_TRUCKS; t++) {
+        const odo_truck_params_t *tr = &p->truck[t];
+        fprintf(f,
+                "%s\n  {\"wheel_diameter_nm\": %" PRIu32 ", \"counts_per_rev_milli\": %" PRIu32
+                ", \"wheelbase_nm\": %" PRIu32 ", \"ed_q30\": %" PRId32 ", \"eb_q30\": %" PRId32
+                ", \"es_q30\": %" PRId32 ", \"flags\": %u}",
+                t == 0 ? "" : ",", tr->wheel_diameter_nm, tr->counts_per_rev_milli, tr->wheelbase_nm,
+                tr->ed_q30, tr->eb_q30, tr->es_q30, tr->flags);
+    }
+    const odo_link_params_t *l = &p->link;
+    fprintf(f, "],\n \"link\": {\"length_nm\": %" PRIu32 ", \"hitch_offset_nm\": %" PRIu32
+               ", \"length_bias_nm\": %" PRId32 ", \"length_ecc_nm\": %" PRId32
+               ", \"alpha_bias_bam\": %" PRId32 ", \"beta_bias_bam\": %" PRId32
+               ", \"rotary_bits\": %u, \"stale_ticks\": %u, \"max_jump_bam\": %" PRIu32
+               ", \"max_length_jump_um\": %" PRIu32 ", \"length_min_um\": %" PRIu32
+               ", \"length_max_um\": %" PRIu32 "}}\n",
+            l->length_nm, l->hitch_offset_nm, l->length_bias_nm, l->length_ecc_nm, l->alpha_bias_bam,
+            l->beta_bias_bam, l->rotary_bits, l->stale_ticks, l->max_jump_bam, l->max_length_jump_um,
+            l->length_min_um, l->length_max_um);
+}
+
+/// Explain a rejected block: detail[] gets the specifics, field[] the offending field (range only).
+static void diagnose(odo_params_status_t st, const uint8_t *b, size_t n, char *detail, size_t dcap,
+                     char *field, size_t fcap)
+{
+    detail[0] = '\0';
+    field[0] = '\0';
+    switch (st) {
+    case ODO_PARAMS_ERR_SHORT:
+        snprintf(detail, dcap, "%zu bytes, a version-%u block is %u", n, ODO_PARAMS_VERSION,
+                 ODO_PARAMS_SIZE);
+        break;
+    case ODO_PARAMS_ERR_MAGIC:
+        snprintf(detail, dcap, "first bytes %02X %02X %02X %02X, expected 4F 44 4F 50 ('ODOP')", b[0],
+                 b[1], b[2], b[3]);
+        break;
+    case ODO_PARAMS_ERR_VERSION:
+        snprintf(detail, dcap, "version %u, this tool knows %u", (unsigned)le16(&b[4]),
+                 ODO_PARAMS_VERSION);
+        break;
+    case ODO_PARAMS_ERR_LENGTH:
+        snprintf(detail, dcap, "declared length %u, version %u blocks are %u", (unsigned)le16(&b[6]),
+                 ODO_PARAMS_VERSION, ODO_PARAMS_SIZE);
+        break;
+    case ODO_PARAMS_ERR_CRC:
+        snprintf(detail, dcap, "stored CRC-32 0x%08" PRIX32 ", computed 0x%08" PRIX32,
+                 le32(&b[ODO_PARAMS_CRC_OFFSET]), odo_crc32(b, ODO_PARAMS_CRC_OFFSET));
+        break;
+    case ODO_PARAMS_ERR_RANGE: {
+        odo_params_t p;
+        uint8_t re[ODO_PARAMS_SIZE];
+        odo_param_field_t f = ODO_PF_NONE;
+        uint8_t t = 0;
+        int reserved_at = -1;
+        parse_unchecked(b, &p);
+        (void)odo_params_validate(&p, &f, &t);
+        (void)odo_params_encode(&p, re, sizeof re);
+        for (unsigned i = 0; i < ODO_PARAMS_CRC_OFFSET; i++) {
+            if (re[i] == b[i]) {
+                continue;
+            }
+            if (!is_reserved_offset(i)) {
+                snprintf(detail, dcap, "internal error: tool layout disagrees with firmware at byte %u", i);
+                return;
+            }
+            if (reserved_at < 0) {
+                reserved_at = (int)i;
+            }
+        }
+        if (f != ODO_PF_NONE) {
+            if (is_truck_field(f)) {
+                snprintf(field, fcap, "truck[%u].%s", (unsigned)t, field_name(f));
+            } else {
+                snprintf(field, fcap, "%s", field_name(f));
+            }
+            if (f == ODO_PF_LENGTH_RANGE) {
+                snprintf(detail, dcap, "field %s = %" PRIu32 "/%" PRIu32 " is outside its documented range",
+                         field, p.link.length_min_um, p.link.length_max_um);
+            } else {
+                snprintf(detail, dcap, "field %s = %lld is outside its documented range", field,
+                         field_value(&p, f, t));
+            }
+        } else if (reserved_at >= 0) {
+            snprintf(field, fcap, "reserved");
+            snprintf(detail, dcap, "reserved byte at offset %d is 0x%02X, must be 0", reserved_at,
+                     b[reserved_at]);
+        }
+        break;
+    }
+    case ODO_PARAMS_OK:
+    case ODO_PARAMS_ERR_ARG:
+        break;
+    }
+}
+
+static int cmd_show(int argc, char **argv)
+{
+    const char *path = NULL;
+    for (int i = 0; i < argc; i++) {
+        if (is_help(argv[i])) {
+            usage_show(stdout);
+            return 0;
+        }
+        if (argv[i][0] == '-' && argv[i][1] != '\0') {
+            fprintf(stderr, "%s: show: unknown option '%s'\n", k_prog, argv[i]);
+            usage_show(stderr);
+            return EXIT_USAGE;
+        }
+        if (path != NULL) {
+            fprintf(stderr, "%s: show: exactly one FILE expected\n", k_prog);
+            usage_show(stderr);
+            return EXIT_USAGE;
+        }
+        path = argv[i];
+    }
+    if (path == NULL) {
+        fprintf(stderr, "%s: show: FILE is required\n", k_prog);
+        usage_show(stderr);
+        return EXIT_USAGE;
+    }
+
+    FILE *f = fopen(path, "rb");
+    if (f == NULL) {
+        fprintf(stderr, "%s: cannot open %s: %s\n", k_prog, path, strerror(errno));
+        return EXIT_REJECTED;
+    }
+    uint8_t *buf = malloc(MAX_INPUT_BYTES + 1);
+    if (buf == NULL) {
+        fclose(f);
+        fprintf(stderr, "%s: out of memory\n", k_prog);
+        return EXIT_REJECTED;
+    }
+    size_t n = fread(buf, 1, MAX_INPUT_BYTES + 1, f);
+    bool read_err = ferror(f) != 0;
+    fclose(f);
+    if (read_err) {
+        fprintf(stderr, "%s: cannot read %s\n", k_prog, path);
+        free(buf);
+        return EXIT_REJECTED;
+    }
+    if (n > MAX_INPUT_BYTES) {
+        fprintf(stderr, "%s: %s: larger than %lu bytes, not a parameter block\n", k_prog, path,
+                MAX_INPUT_BYTES);
+        free(buf);
+        return EXIT_REJECTED;
+    }
+
+    odo_params_t p;
+    odo_params_status_t st = odo_params_decode(buf, n, &p);
+    if (st == ODO_PARAMS_OK) {
+        print_json(stdout, path, buf, &p);
+        free(buf);
+        return 0;
+    }
+
+    char detail[160];
+    char field[64];
+    diagnose(st, buf, n, detail, sizeof detail, field, sizeof field);
+    printf("{\"file\": ");
+    json_str(stdout, path);
+    printf(", \"status\": \"%s\", \"reason\": ", status_key(st));
+    json_str(stdout, odo_params_status_str(st));
+    if (field[0] != '\0') {
+        printf(", \"field\": ");
+        json_str(stdout, field);
+    }
+    if (detail[0] != '\0') {
+        printf(", \"detail\": ");
+        json_str(stdout, detail);
+    }
+    printf("}\n");
+    fprintf(stderr, "%s: %s: rejected: %s%s%s\n", k_prog, path, odo_params_status_str(st),
+            detail[0] != '\0' ? ": " : "", detail);
+    free(buf);
+    return EXIT_REJECTED;
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 2) {
+        usage_main(stderr);
+        return EXIT_USAGE;
+    }
+    if (is_help(argv[1])) {
+        usage_main(stdout);
+        return 0;
+    }
+    if (strcmp(argv[1], "defaults") == 0) {
+        return cmd_defaults(argc - 2, argv + 2);
+    }
+    if (strcmp(argv[1], "show") == 0) {
+        return cmd_show(argc - 2, argv + 2);
+    }
+    fprintf(stderr, "%s: unknown command '%s'\n", k_prog, argv[1]);
+    usage_main(stderr);
+    return EXIT_USAGE;
+}
