@@ -1,0 +1,173 @@
+/// The 40 ms application step (see odo_app.h). Pure: no HAL, no globals.
+#include "odo/odo_app.h"
+
+#include "odo/odo_can.h"
+
+/// Initial poses: truck A at the origin heading +x; the rear truck (clapper, 004 Fig. 6) or the
+/// trailer axle (set) straight behind it, so Eq. 16 holds from the first tick.
+static void reset_poses(odo_app_t *app)
+{
+    const odo_link_params_t *l = &app->params.link;
+    odo_pose_t pose = {0, 0, 0U};
+    odo_truck_reset(&app->truck[ODO_TRUCK_A], &pose);
+    uint64_t behind_nm = 0U;
+    if (app->params.vehicle == (uint8_t)ODO_VEHICLE_CLAPPER) {
+        behind_nm = l->length_nm;
+    } else if (app->params.vehicle == (uint8_t)ODO_VEHICLE_SET) {
+        behind_nm = (uint64_t)l->hitch_offset_nm + l->length_nm;
+    }
+    /* nm -> mm Q32: * 2^32 / 10^6, exact enough (< 1e-9 mm) and within int64 for <= 15 m. */
+    pose.x_mm_q32 = -(int64_t)((behind_nm << 32) / 1000000U);
+    odo_truck_reset(&app->truck[ODO_TRUCK_B], &pose);
+}
+
+static bool init_models(odo_app_t *app, const odo_params_t *p)
+{
+    for (uint8_t i = 0U; i < ODO_TRUCKS; ++i) {
+        if (odo_model_init(&app->model[i], &p->truck[i], p->counter_bits, p->heading_form, p->tick_us,
+                           p->max_wheel_speed_mm_s) != ODO_MODEL_OK) {
+            return false;
+        }
+    }
+    return true;
+}
+
+odo_params_status_t odo_app_init_params(odo_app_t *app, const odo_params_t *p)
+{
+    memset(app, 0, sizeof *app);
+    odo_params_status_t st = odo_params_validate(p, NULL, NULL);
+    if (st == ODO_PARAMS_OK && !init_models(app, p)) {
+        st = ODO_PARAMS_ERR_RANGE; /* valid fields, but multipliers that do not fit: see odometry */
+    }
+    if (st == ODO_PARAMS_OK) {
+        app->params = *p;
+    } else {
+        odo_params_defaults(&app->params);
+        (void)init_models(app, &app->params); /* the defaults always fit (unit-tested) */
+    }
+    app->params_status = st;
+    app->trucks = (app->params.vehicle == (uint8_t)ODO_VEHICLE_SINGLE) ? 1U : 2U;
+    reset_poses(app);
+    return st;
+}
+
+odo_params_status_t odo_app_init(odo_app_t *app, const uint8_t *block, size_t len)
+{
+    odo_params_t p;
+    const odo_params_status_t load = odo_params_load(block, len, &p);
+    const odo_params_status_t st = odo_app_init_params(app, &p);
+    if (load != ODO_PARAMS_OK) {
+        app->params_status = load;
+        return load;
+    }
+    return st;
+}
+
+static void count_faults(odo_fault_counters_t *c, uint32_t faults)
+{
+    for (unsigned b = 0U; b < ODO_FAULT_COUNT; ++b) {
+        if ((faults & (1UL << b)) != 0U && c->count[b] != UINT32_MAX) {
+            c->count[b]++;
+        }
+    }
+}
+
+/// Sequence check of a truck's wheel frames: a repeat is a duplicate, a skip is lost frames.
+/// Counters are cumulative, so integrating after a gap is still exact (only resolution is lost).
+static uint32_t check_seq(odo_app_t *app, uint8_t truck, uint8_t seq)
+{
+    uint32_t f = 0U;
+    if (app->seen_seq[truck]) {
+        const uint8_t step = (uint8_t)(seq - app->last_seq[truck]);
+        if (step == 0U) {
+            f |= ODO_FAULT_SEQ_DUP;
+        } else if (step != 1U) {
+            f |= ODO_FAULT_SEQ_GAP;
+        }
+    }
+    app->seen_seq[truck] = true;
+    app->last_seq[truck] = seq;
+    return f;
+}
+
+static const uint32_t FAULT_MISSING[ODO_TRUCKS] = {ODO_FAULT_WHEEL_MISSING_A, ODO_FAULT_WHEEL_MISSING_B};
+static const uint32_t FAULT_JUMP[ODO_TRUCKS] = {ODO_FAULT_COUNTER_JUMP_A, ODO_FAULT_COUNTER_JUMP_B};
+static const uint32_t FAULT_DECODER[ODO_TRUCKS] = {ODO_FAULT_DECODER_A, ODO_FAULT_DECODER_B};
+
+/// Occurrence count of one fault bit.
+static uint32_t fault_count(const odo_fault_counters_t *c, uint32_t mask)
+{
+    for (unsigned b = 0U; b < ODO_FAULT_COUNT; ++b) {
+        if (mask == (1UL << b)) {
+            return c->count[b];
+        }
+    }
+    return 0U;
+}
+
+static void publish(const odo_app_t *app, const uint8_t pose_flags[ODO_TRUCKS], odo_tick_output_t *out)
+{
+    uint8_t n = 0U;
+    for (uint8_t i = 0U; i < app->trucks; ++i) {
+        const odo_msg_pose_xy_t xy = {odo_mm_q32_to_10um(out->pose[i].x_mm_q32),
+                                      odo_mm_q32_to_10um(out->pose[i].y_mm_q32)};
+        const odo_msg_pose_theta_t th = {odo_heading_bam(&out->pose[i]), app->out_seq, pose_flags[i]};
+        odo_can_pack_pose_xy(i, &xy, &out->frames[n++]);
+        odo_can_pack_pose_theta(i, &th, &out->frames[n++]);
+    }
+    if (app->trucks == 2U) {
+        const odo_msg_ipec_corr_t corr = {out->ipec_dtheta_bam[0], out->ipec_dtheta_bam[1]};
+        odo_can_pack_ipec_corr(&corr, &out->frames[n++]);
+    }
+    const uint64_t rejected = (uint64_t)fault_count(&app->faults, ODO_FAULT_CAN_BAD_DLC) +
+                              fault_count(&app->faults, ODO_FAULT_CAN_UNKNOWN_ID);
+    const odo_msg_status_t st = {out->faults, app->out_seq, (uint8_t)app->params_status,
+                                 (uint16_t)(rejected > UINT16_MAX ? UINT16_MAX : rejected)};
+    odo_can_pack_status(&st, &out->frames[n++]);
+    out->n_frames = n;
+}
+
+void odo_app_step(odo_app_t *app, const odo_tick_input_t *in, odo_tick_output_t *out)
+{
+    uint32_t faults = in->rx_faults;
+    uint8_t pose_flags[ODO_TRUCKS] = {0U, 0U};
+    memset(out, 0, sizeof *out);
+
+    if (app->params_status != ODO_PARAMS_OK) {
+        faults |= ODO_FAULT_PARAMS_DEFAULTED;
+    }
+    if (app->have_time && in->t_us < app->last_t_us) {
+        faults |= ODO_FAULT_TIME_BACKWARDS; /* still stepped: counts, not time, carry the motion */
+    }
+    app->have_time = true;
+    app->last_t_us = in->t_us;
+
+    for (uint8_t i = 0U; i < app->trucks; ++i) {
+        const odo_wheel_input_t *w = &in->wheel[i];
+        if (!w->present) {
+            faults |= FAULT_MISSING[i];
+            pose_flags[i] |= ODO_POSE_FLAG_MISSING;
+            continue;
+        }
+        faults |= check_seq(app, i, w->seq);
+        if ((w->status & (ODO_WHEEL_STATUS_LEFT_SKIPPED | ODO_WHEEL_STATUS_RIGHT_SKIPPED |
+                          ODO_WHEEL_STATUS_LEFT_FAULT | ODO_WHEEL_STATUS_RIGHT_FAULT)) != 0U) {
+            faults |= FAULT_DECODER[i];
+        }
+        odo_step_t st;
+        odo_truck_step(&app->truck[i], &app->model[i], w->left_raw, w->right_raw, w->bits, &st);
+        if (st.jump) {
+            faults |= FAULT_JUMP[i];
+            pose_flags[i] |= ODO_POSE_FLAG_JUMP;
+        }
+    }
+
+    for (uint8_t i = 0U; i < ODO_TRUCKS; ++i) {
+        out->pose[i] = app->truck[i].pose;
+    }
+    out->faults = faults;
+    count_faults(&app->faults, faults);
+    publish(app, pose_flags, out);
+    app->out_seq++;
+    app->ticks++;
+}

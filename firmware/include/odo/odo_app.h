@@ -1,0 +1,73 @@
+/// The 40 ms application step: one pure function over a tick input and the application state.
+/// host_sim, odo-replay (offline and live), the vcan test and the Cortex-M image all call
+/// odo_app_step; only firmware/app/odo_loop.c touches the HAL around it.
+///
+/// Per tick: sequence/fault bookkeeping -> per-truck odometry (odo_odometry.h) -> [IPEC] -> output
+/// frames (pose per truck, IPEC corrections, status) packed with the DBC codec (odo_can.h).
+#ifndef ODO_APP_H
+#define ODO_APP_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "odo/odo_odometry.h"
+#include "odo/odo_params.h"
+#include "odo/odo_status.h"
+#include "odo/odo_types.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/// Most frames one step publishes: pose XY+theta for two trucks, IPEC corrections, status.
+#define ODO_APP_MAX_FRAMES 6U
+
+/// Flags byte of the POSE_THETA frames: what happened to that truck's pose this tick.
+#define ODO_POSE_FLAG_MISSING 0x01U ///< no wheel sample: pose held
+#define ODO_POSE_FLAG_JUMP    0x02U ///< implausible counter jump: pose held, baseline re-taken
+#define ODO_POSE_FLAG_IPEC    0x04U ///< an IPEC heading correction was applied
+
+/// Application state. Plain data, caller-allocated (static on the target); no pointers inside,
+/// so it can be copied to checkpoint a run.
+typedef struct {
+    odo_params_t         params;
+    odo_params_status_t  params_status;  ///< result of the boot-time load (OK or why defaulted)
+    odo_model_t          model[ODO_TRUCKS];
+    odo_truck_t          truck[ODO_TRUCKS];
+    uint8_t              trucks;         ///< 1 (single) or 2 (clapper, set)
+    uint8_t              out_seq;        ///< sequence number of the output frames
+    bool                 seen_seq[ODO_TRUCKS];
+    uint8_t              last_seq[ODO_TRUCKS];
+    bool                 have_time;
+    uint64_t             last_t_us;
+    uint32_t             ticks;          ///< steps run since init
+    uint32_t             tx_dropped;     ///< output frames the HAL could not queue (odo_loop)
+    odo_fault_counters_t faults;         ///< occurrences per fault bit, saturating
+} odo_app_t;
+
+/// What one step produced.
+typedef struct {
+    odo_pose_t      pose[ODO_TRUCKS];
+    int32_t         ipec_dtheta_bam[ODO_TRUCKS]; ///< correction applied this tick (0 when off/gated)
+    uint32_t        faults;                      ///< ODO_FAULT_* bits raised this tick
+    uint8_t         n_frames;
+    odo_can_frame_t frames[ODO_APP_MAX_FRAMES];  ///< to publish, in order
+} odo_tick_output_t;
+
+/// Boot: load the parameter block (odo_params_load: defaults on any failure), precompute the
+/// models, reset both trucks to the origin heading +x. Returns the load status; on anything but
+/// ODO_PARAMS_OK every later step raises ODO_FAULT_PARAMS_DEFAULTED. `block` may be NULL (len 0)
+/// to boot on defaults deliberately (still flagged).
+odo_params_status_t odo_app_init(odo_app_t *app, const uint8_t *block, size_t len);
+
+/// Same as odo_app_init, from already-decoded parameters (host tools). Returns ODO_PARAMS_ERR_RANGE
+/// and boots on defaults if they fail validation or the model precomputation.
+odo_params_status_t odo_app_init_params(odo_app_t *app, const odo_params_t *p);
+
+/// One application step. Pure: reads *in and *app, writes *app and *out. Constant time.
+void odo_app_step(odo_app_t *app, const odo_tick_input_t *in, odo_tick_output_t *out);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

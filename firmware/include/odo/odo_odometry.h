@@ -1,0 +1,93 @@
+/// Per-truck dead reckoning from raw, wrapping wheel counters (000 Eqs. 2.1-2.6), with the UMBmark
+/// per-wheel correction factors cL, cR (000 Eqs. 6.33-6.35), the effective wheelbase (Eq. 6.28) and
+/// the scale correction (App. B) folded into two per-wheel multipliers when parameters load.
+///
+/// Representations: position in mm Q32 (int64), heading in turns Q64 (uint64, wraps), per-wheel
+/// distance per count in mm Q40, per-wheel heading per count in turns Q64. One tick costs two
+/// 64x64 multiplies for the heading, two for distance and two 64x32 for position; no loops.
+///
+/// Accuracy (tests/host/test_odometry_reference.c and odo-bench): against a double-precision
+/// reference fed the same counts, after 1 km of mixed driving the pose differs by <= 0.1 mm and
+/// <= 1e-6 rad.
+#ifndef ODO_ODOMETRY_H
+#define ODO_ODOMETRY_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "odo/odo_params.h"
+#include "odo/odo_types.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/// Per-truck multipliers, precomputed by odo_model_init from one odo_truck_params_t.
+typedef struct {
+    int64_t  dist_mm_q40[2];  ///< distance per count, [ODO_LEFT, ODO_RIGHT]: cL/R * cm (Eq. 6.35)
+    uint64_t turn_q64[2];     ///< heading change per count: dist / (2 pi b_eff) (Eq. 2.4), turns Q64
+    uint32_t max_counts;      ///< largest believable |delta| per tick (from max_wheel_speed_mm_s)
+    uint8_t  counter_bits;    ///< decoder counter width (16, 24, 32)
+    uint8_t  invert;          ///< ODO_TRUCK_INVERT_* flags
+    uint8_t  heading_form;    ///< odo_heading_form_t
+} odo_model_t;
+
+/// A truck's dead-reckoning state.
+typedef struct {
+    odo_pose_t pose;
+    uint32_t   last_raw[2]; ///< last accepted raw counter values
+    bool       primed;      ///< last_raw holds a reading (the first reading only sets the baseline)
+} odo_truck_t;
+
+/// What one odometry step did.
+typedef struct {
+    int64_t  dist_mm_q40;  ///< centre-point displacement U_i (000 Eq. 2.3), mm Q40
+    int64_t  dturn_q64;    ///< heading change dtheta_i (000 Eq. 2.4), signed turns Q64
+    int32_t  delta[2];     ///< accepted count deltas, forward positive
+    bool     jump;         ///< a delta exceeded max_counts: nothing integrated, baseline re-taken
+} odo_step_t;
+
+typedef enum {
+    ODO_MODEL_OK = 0,
+    ODO_MODEL_ERR_RANGE,    ///< the parameters give multipliers that do not fit the number formats
+} odo_model_status_t;
+
+/// Precompute the multipliers for one truck (integer 128-bit arithmetic; a few microseconds).
+///   cm     = pi * (Dn / Es) / counts_per_rev              (000 Eq. 2.1 with App. B: Dn* = Dn/Es)
+///   cL, cR = 2 / (Ed + 1), 2 / (1/Ed + 1)                  (000 Eqs. 6.33, 6.34)
+///   b_eff  = Eb * b_nominal                               (000 Eq. 6.28 via Eq. 2.8)
+/// Note on App. B: Eq. B.1 defines Es = L_calc/L_actual, so the diameter that makes L_calc equal
+/// L_actual is Dn/Es; the transcription's "Dn* = Es Dn" (B.2) contradicts B.1 and is not used.
+/// Returns ODO_MODEL_ERR_RANGE (and leaves *m untouched) if a multiplier would overflow its format
+/// or max_counts * distance exceeds 2^61 mm Q40; params must already pass odo_params_validate.
+odo_model_status_t odo_model_init(odo_model_t *m, const odo_truck_params_t *tp, uint8_t counter_bits,
+                                  uint8_t heading_form, uint32_t tick_us,
+                                  uint32_t max_wheel_speed_mm_s);
+
+/// Signed difference cur - prev of two raw counter readings modulo 2^bits (bits in [1, 32]),
+/// interpreted in [-2^(bits-1), 2^(bits-1)). Handles every wrap of a 16, 24 or 32-bit counter.
+int32_t odo_count_delta(uint32_t prev, uint32_t cur, uint8_t bits);
+
+/// Reset a truck to a pose; the next reading sets the counter baseline.
+void odo_truck_reset(odo_truck_t *t, const odo_pose_t *pose);
+
+/// One dead-reckoning step from raw counter readings (000 Eqs. 2.2-2.6).
+/// `bits` is the width the readings carry (a CAN frame carries 24); the modulus used is
+/// 2^min(bits, model counter_bits). On a jump (|delta| > max_counts on either wheel) the pose is
+/// not changed, the baseline is re-taken, and out->jump is true. Never fails otherwise.
+void odo_truck_step(odo_truck_t *t, const odo_model_t *m, uint32_t left_raw, uint32_t right_raw,
+                    uint8_t bits, odo_step_t *out);
+
+/// Advance a pose by a centre displacement and heading change (000 Eqs. 2.5, 2.6), with the
+/// midpoint or the paper's heading form. Shared by odometry and IPEC re-integration.
+void odo_pose_advance(odo_pose_t *p, int64_t dist_mm_q40, int64_t dturn_q64, uint8_t heading_form);
+
+/// Conversions for output: heading as BAM (rounded), position in units of 10 um (rounded,
+/// saturating to int32).
+uint32_t odo_heading_bam(const odo_pose_t *p);
+int32_t  odo_mm_q32_to_10um(int64_t v_mm_q32);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

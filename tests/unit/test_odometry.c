@@ -1,0 +1,247 @@
+/// Per-truck odometry (000 Eqs. 2.1-2.6, 6.28, 6.33-6.35, App. B) on the fixed-point core.
+/// Doubles appear only as test references.
+#include <math.h>
+#include <stdint.h>
+
+#include "odo/odo_odometry.h"
+#include "test_support.h"
+#include "unity.h"
+
+void setUp(void) {}
+void tearDown(void) {}
+
+#define Q30(x) ((int32_t)llround((x) * 1073741824.0))
+#define MM_Q32(v) ((double)(v) / 4294967296.0)
+#define TURNS_Q64_TO_RAD(v) ((double)(int64_t)(v) / 18446744073709551616.0 * 2.0 * M_PI)
+
+static odo_truck_params_t labmate(void)
+{
+    odo_params_t p;
+    odo_params_defaults(&p);
+    return p.truck[0];
+}
+
+static odo_model_t model_of(const odo_truck_params_t *tp, uint8_t bits, uint8_t form)
+{
+    odo_model_t m;
+    TEST_ASSERT_EQUAL(ODO_MODEL_OK, odo_model_init(&m, tp, bits, form, 40000U, 3000U));
+    return m;
+}
+
+static double cm_mm(const odo_truck_params_t *tp)
+{
+    return M_PI * (tp->wheel_diameter_nm * 1e-6 / (tp->es_q30 / 1073741824.0)) /
+           (tp->counts_per_rev_milli * 1e-3);
+}
+
+static void multipliers_follow_eqs_2_1_6_33_6_34_and_6_28(void)
+{
+    /* 000 Eq. 6.35: DU = c * cm * N; Eq. 6.33/6.34: cL = 2/(Ed+1), cR = 2/(1/Ed+1); Eq. 6.28. */
+    odo_truck_params_t tp = labmate();
+    tp.ed_q30 = Q30(1.0042);
+    tp.eb_q30 = Q30(0.9871);
+    tp.es_q30 = Q30(1.0123);
+    const odo_model_t m = model_of(&tp, 24U, ODO_HEADING_MIDPOINT);
+    const double ed = tp.ed_q30 / 1073741824.0, eb = tp.eb_q30 / 1073741824.0;
+    const double kl = 2.0 / (ed + 1.0) * cm_mm(&tp), kr = 2.0 / (1.0 / ed + 1.0) * cm_mm(&tp);
+    const double b_eff = eb * 340.0;
+    /* within half an LSB of the Q40 format (plus the reference's own rounding) */
+    const double half_lsb = 0.5 / 1099511627776.0 + 1e-15;
+    TEST_ASSERT_DOUBLE_WITHIN(half_lsb, kl, m.dist_mm_q40[0] / 1099511627776.0);
+    TEST_ASSERT_DOUBLE_WITHIN(half_lsb, kr, m.dist_mm_q40[1] / 1099511627776.0);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-9, ed, (double)m.dist_mm_q40[1] / (double)m.dist_mm_q40[0]);
+    const double tl = kl / (2.0 * M_PI * b_eff), tr = kr / (2.0 * M_PI * b_eff);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-12 * tl, tl, m.turn_q64[0] / 18446744073709551616.0);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-12 * tr, tr, m.turn_q64[1] / 18446744073709551616.0);
+    /* max counts: 3 m/s for 40 ms over the smaller k, plus one */
+    TEST_ASSERT_UINT32_WITHIN(1U, (uint32_t)ceil(120.0 / kl) + 1U, m.max_counts);
+}
+
+static void count_delta_handles_every_wrap_of_16_24_32_bit_counters(void)
+{
+    TEST_ASSERT_EQUAL_INT32(2, odo_count_delta(0xFFFFU, 0x0001U, 16U));
+    TEST_ASSERT_EQUAL_INT32(-2, odo_count_delta(0x0001U, 0xFFFFU, 16U));
+    TEST_ASSERT_EQUAL_INT32(32767, odo_count_delta(0U, 0x7FFFU, 16U));
+    TEST_ASSERT_EQUAL_INT32(-32768, odo_count_delta(0U, 0x8000U, 16U));
+    TEST_ASSERT_EQUAL_INT32(5, odo_count_delta(0xFFFFFEU, 0x000003U, 24U));
+    TEST_ASSERT_EQUAL_INT32(-8388608, odo_count_delta(0U, 0x800000U, 24U));
+    TEST_ASSERT_EQUAL_INT32(1, odo_count_delta(0xFFFFFFFFU, 0U, 32U));
+    TEST_ASSERT_EQUAL_INT32(INT32_MIN, odo_count_delta(0U, 0x80000000U, 32U));
+    TEST_ASSERT_EQUAL_INT32(INT32_MAX, odo_count_delta(0U, 0x7FFFFFFFU, 32U));
+    /* bits above the counter width are ignored (a 16-bit value carried in a 24-bit field) */
+    TEST_ASSERT_EQUAL_INT32(3, odo_count_delta(0xAB0FFFFU, 0x0002U, 16U));
+    ts_rng_t rng;
+    ts_rng_seed(&rng, 24U);
+    const uint8_t widths[] = {16U, 24U, 32U};
+    for (int n = 0; n < 100000; ++n) {
+        const uint8_t bits = widths[n % 3];
+        const int64_t half = (int64_t)1 << (bits - 1U);
+        const int64_t start = ts_rng_range(&rng, 0, 2 * half - 1);
+        const int64_t delta = ts_rng_range(&rng, -half, half - 1);
+        TEST_ASSERT_EQUAL_INT32((int32_t)delta, odo_count_delta(ts_wrap_counter(start, bits),
+                                                                ts_wrap_counter(start + delta, bits), bits));
+    }
+}
+
+static void straight_line_keeps_heading_and_lateral_position_exact(void)
+{
+    const odo_truck_params_t tp = labmate();
+    const odo_model_t m = model_of(&tp, 24U, ODO_HEADING_MIDPOINT);
+    odo_truck_t t;
+    const odo_pose_t origin = {0, 0, 0U};
+    odo_truck_reset(&t, &origin);
+    odo_step_t st;
+    uint32_t c = 0xFFF000U; /* starts close to the 24-bit wrap */
+    odo_truck_step(&t, &m, c, c, 24U, &st);
+    for (int i = 0; i < 5000; ++i) {
+        c = (c + 661U) & 0xFFFFFFU;
+        odo_truck_step(&t, &m, c, c, 24U, &st);
+        TEST_ASSERT_FALSE(st.jump);
+    }
+    TEST_ASSERT_EQUAL_UINT64(0U, t.pose.heading_q64);
+    TEST_ASSERT_EQUAL_INT64(0, t.pose.y_mm_q32);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-6, 5000.0 * 661.0 * cm_mm(&tp), MM_Q32(t.pose.x_mm_q32));
+}
+
+static void on_the_spot_turn_changes_heading_not_position(void)
+{
+    const odo_truck_params_t tp = labmate();
+    const odo_model_t m = model_of(&tp, 24U, ODO_HEADING_MIDPOINT);
+    odo_truck_t t;
+    const odo_pose_t origin = {0, 0, 0U};
+    odo_truck_reset(&t, &origin);
+    odo_step_t st;
+    odo_truck_step(&t, &m, 0U, 0U, 24U, &st);
+    int64_t n = 0;
+    for (int i = 1; i <= 250; ++i) { /* 250 ticks of +-300 counts */
+        n += 300;
+        odo_truck_step(&t, &m, ts_wrap_counter(-n, 24U), ts_wrap_counter(n, 24U), 24U, &st);
+    }
+    const double want = 2.0 * (double)n * cm_mm(&tp) / 340.0; /* Eq. 2.4 summed */
+    const double got = TURNS_Q64_TO_RAD(t.pose.heading_q64);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-9, remainder(want, 2.0 * M_PI), got);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-6, 0.0, MM_Q32(t.pose.x_mm_q32));
+    TEST_ASSERT_DOUBLE_WITHIN(1e-6, 0.0, MM_Q32(t.pose.y_mm_q32));
+}
+
+/// Drive a quarter of a constant-curvature arc; return the end-point error against the exact arc.
+static double arc_end_error_mm(uint8_t form)
+{
+    const odo_truck_params_t tp = labmate();
+    const odo_model_t m = model_of(&tp, 32U, form);
+    const int32_t dl = 1500, dr = 1800; /* counts per tick */
+    const double k = cm_mm(&tp), b = 340.0;
+    const double dth = (dr - dl) * k / b, u = 0.5 * (dl + dr) * k;
+    const int ticks = (int)floor((M_PI / 2.0) / dth);
+    odo_truck_t t;
+    const odo_pose_t origin = {0, 0, 0U};
+    odo_truck_reset(&t, &origin);
+    odo_step_t st;
+    odo_truck_step(&t, &m, 0U, 0U, 32U, &st);
+    for (int i = 1; i <= ticks; ++i) {
+        odo_truck_step(&t, &m, (uint32_t)(i * dl), (uint32_t)(i * dr), 32U, &st);
+    }
+    const double r = u / dth, th = ticks * dth; /* exact circle through the origin, heading +x */
+    return hypot(MM_Q32(t.pose.x_mm_q32) - r * sin(th), MM_Q32(t.pose.y_mm_q32) - r * (1.0 - cos(th)));
+}
+
+static void midpoint_form_is_far_more_accurate_than_eq_2_6_on_arcs(void)
+{
+    /* Eq. 2.6 advances along the new heading: an error of order U*dtheta/2 per tick that adds up;
+     * the midpoint form is exact in direction and only shortens each chord by dtheta^2/24. */
+    const double mid = arc_end_error_mm(ODO_HEADING_MIDPOINT);
+    const double paper = arc_end_error_mm(ODO_HEADING_PAPER);
+    TEST_ASSERT_TRUE_MESSAGE(mid < 0.05, "midpoint error on a quarter arc");
+    TEST_ASSERT_TRUE_MESSAGE(paper > 5.0, "Eq. 2.6 form should show its first-order error");
+    TEST_ASSERT_TRUE(paper > 100.0 * mid);
+}
+
+static void unequal_wheels_are_corrected_per_eq_6_35(void)
+{
+    /* A robot with a larger right wheel (Ed > 1) that counts equally on both wheels really turns
+     * left; the calibrated model must say so, with the rate of Eq. 2.4 on the corrected distances. */
+    odo_truck_params_t tp = labmate();
+    tp.ed_q30 = Q30(1.01);
+    const odo_model_t m = model_of(&tp, 24U, ODO_HEADING_MIDPOINT);
+    odo_truck_t t;
+    const odo_pose_t origin = {0, 0, 0U};
+    odo_truck_reset(&t, &origin);
+    odo_step_t st;
+    odo_truck_step(&t, &m, 0U, 0U, 24U, &st);
+    odo_truck_step(&t, &m, 1000U, 1000U, 24U, &st);
+    const double ed = tp.ed_q30 / 1073741824.0;
+    const double want = 1000.0 * cm_mm(&tp) * (2.0 / (1.0 / ed + 1.0) - 2.0 / (ed + 1.0)) / 340.0;
+    TEST_ASSERT_TRUE(st.dturn_q64 > 0);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-12, want, TURNS_Q64_TO_RAD(t.pose.heading_q64));
+    /* Eq. 6.30: the mean wheel diameter is kept, so the centre moves exactly 1000 * cm. */
+    TEST_ASSERT_DOUBLE_WITHIN(1e-9, 1000.0 * cm_mm(&tp), (double)st.dist_mm_q40 / 1099511627776.0);
+}
+
+static void implausible_counter_jump_is_flagged_not_integrated(void)
+{
+    const odo_truck_params_t tp = labmate();
+    const odo_model_t m = model_of(&tp, 24U, ODO_HEADING_MIDPOINT);
+    odo_truck_t t;
+    const odo_pose_t origin = {0, 0, 0U};
+    odo_truck_reset(&t, &origin);
+    odo_step_t st;
+    odo_truck_step(&t, &m, 100U, 100U, 24U, &st);
+    odo_truck_step(&t, &m, 100U + m.max_counts, 100U, 24U, &st); /* exactly at the limit: fine */
+    TEST_ASSERT_FALSE(st.jump);
+    const odo_pose_t before = t.pose;
+    const uint32_t base = 100U + m.max_counts;
+    odo_truck_step(&t, &m, base + m.max_counts + 1U, 100U, 24U, &st); /* one count too many */
+    TEST_ASSERT_TRUE(st.jump);
+    TEST_ASSERT_EQUAL_INT64(before.x_mm_q32, t.pose.x_mm_q32);
+    TEST_ASSERT_EQUAL_UINT64(before.heading_q64, t.pose.heading_q64);
+    /* the next tick integrates from the re-taken baseline */
+    odo_truck_step(&t, &m, base + m.max_counts + 11U, 110U, 24U, &st);
+    TEST_ASSERT_FALSE(st.jump);
+    TEST_ASSERT_EQUAL_INT32(10, st.delta[0]);
+    TEST_ASSERT_EQUAL_INT32(10, st.delta[1]);
+}
+
+static void inverted_encoders_count_forward(void)
+{
+    odo_truck_params_t tp = labmate();
+    tp.flags = ODO_TRUCK_INVERT_LEFT;
+    const odo_model_t m = model_of(&tp, 16U, ODO_HEADING_MIDPOINT);
+    odo_truck_t t;
+    const odo_pose_t origin = {0, 0, 0U};
+    odo_truck_reset(&t, &origin);
+    odo_step_t st;
+    odo_truck_step(&t, &m, 5U, 5U, 16U, &st);
+    odo_truck_step(&t, &m, ts_wrap_counter(5 - 400, 16U), 405U, 16U, &st);
+    TEST_ASSERT_EQUAL_INT32(400, st.delta[0]);
+    TEST_ASSERT_EQUAL_INT32(400, st.delta[1]);
+    TEST_ASSERT_EQUAL_INT64(0, st.dturn_q64);
+}
+
+static void parameters_that_cannot_be_represented_are_refused(void)
+{
+    odo_truck_params_t tp = labmate();
+    odo_model_t m;
+    /* 3 m/s at 40 ms needs ~9900 counts per tick: more than half a 16-bit counter? no; but with a
+     * very fine encoder it is, and the modular delta would be ambiguous. */
+    tp.counts_per_rev_milli = 4000000000U; /* 4e6 counts per turn */
+    TEST_ASSERT_EQUAL(ODO_MODEL_ERR_RANGE, odo_model_init(&m, &tp, 16U, 0U, 40000U, 3000U));
+    TEST_ASSERT_EQUAL(ODO_MODEL_OK, odo_model_init(&m, &tp, 32U, 0U, 40000U, 3000U));
+    tp = labmate();
+    tp.ed_q30 = 0;
+    TEST_ASSERT_EQUAL(ODO_MODEL_ERR_RANGE, odo_model_init(&m, &tp, 24U, 0U, 40000U, 3000U));
+}
+
+int main(void)
+{
+    UNITY_BEGIN();
+    RUN_TEST(multipliers_follow_eqs_2_1_6_33_6_34_and_6_28);
+    RUN_TEST(count_delta_handles_every_wrap_of_16_24_32_bit_counters);
+    RUN_TEST(straight_line_keeps_heading_and_lateral_position_exact);
+    RUN_TEST(on_the_spot_turn_changes_heading_not_position);
+    RUN_TEST(midpoint_form_is_far_more_accurate_than_eq_2_6_on_arcs);
+    RUN_TEST(unequal_wheels_are_corrected_per_eq_6_35);
+    RUN_TEST(implausible_counter_jump_is_flagged_not_integrated);
+    RUN_TEST(inverted_encoders_count_forward);
+    RUN_TEST(parameters_that_cannot_be_represented_are_refused);
+    return UNITY_END();
+}
