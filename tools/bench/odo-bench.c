@@ -1,0 +1,189 @@
+/// odo-bench: benchmark figures as one JSON object. Built optimised and without sanitizers in
+/// every preset, so the figures mean the same everywhere. Timing-free: accuracy figures are
+/// computed, and the cost of a step is counted in instructions by callgrind, which is repeatable
+/// on a loaded machine (wall-clock figures added by later issues are reported beside a reference).
+#include <errno.h>
+#include <inttypes.h>
+#include <limits.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/types.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "odo/odo_app.h"
+#include "odo_refcheck.h"
+#include "odo_synth.h"
+#include "trig_accuracy.h"
+
+#define KERNEL_STEPS 20000U
+
+static void usage(FILE *f)
+{
+    fprintf(f,
+            "usage: odo-bench [--json] [--quick]\n"
+            "\n"
+            "Prints the firmware's benchmark figures:\n"
+            "  pos_err_mm_1km, heading_err_rad_1km  fixed point vs double after 1 km of mixed\n"
+            "                                       driving (worst of 6 runs; targets 0.1, 1e-6)\n"
+            "  sincos_max_abs_err, atan2_max_abs_err_rad  vs libm over 10^6 random inputs + edges\n"
+            "  step_instructions                    x86-64 instructions per 40 ms application\n"
+            "                                       step for two trucks, counted by callgrind\n"
+            "  --json   one JSON object on stdout (progress goes to stderr)\n"
+            "  --quick  fewer samples (for smoke tests; figures are then indicative only)\n");
+}
+
+/// Hidden mode run under callgrind: KERNEL_STEPS application steps of a clapper (two trucks).
+static int run_kernel(void)
+{
+    static odo_app_t app;
+    static odo_tick_output_t out;
+    odo_params_t p;
+    odo_params_defaults(&p);
+    p.vehicle = ODO_VEHICLE_CLAPPER;
+    if (odo_app_init_params(&app, &p) != ODO_PARAMS_OK) {
+        return 2;
+    }
+    odo_synth_t s[2];
+    odo_synth_init(&s[0], 1U, &p.truck[0], p.tick_us);
+    odo_synth_init(&s[1], 2U, &p.truck[1], p.tick_us);
+    int64_t c[2][2] = {{0, 0}, {0, 0}};
+    uint64_t sink = 0U;
+    for (uint32_t i = 0U; i < KERNEL_STEPS; ++i) {
+        odo_tick_input_t in;
+        memset(&in, 0, sizeof in);
+        in.t_us = (uint64_t)i * p.tick_us;
+        for (int t = 0; t < 2; ++t) {
+            int32_t dl, dr;
+            odo_synth_next(&s[t], &dl, &dr);
+            c[t][0] += dl;
+            c[t][1] += dr;
+            in.wheel[t].present = true;
+            in.wheel[t].bits = 24U;
+            in.wheel[t].seq = (uint8_t)i;
+            in.wheel[t].left_raw = (uint32_t)((uint64_t)c[t][0] & 0xFFFFFFU);
+            in.wheel[t].right_raw = (uint32_t)((uint64_t)c[t][1] & 0xFFFFFFU);
+        }
+        odo_app_step(&app, &in, &out);
+        sink += out.frames[0].data[0];
+    }
+    return sink == UINT64_MAX ? 3 : 0;
+}
+
+/// Count instructions inside odo_app_step with callgrind. Returns -1 if valgrind is unavailable.
+static double step_instructions(char *tool, size_t tool_len)
+{
+    char self[PATH_MAX];
+    const ssize_t n = readlink("/proc/self/exe", self, sizeof self - 1U);
+    if (n <= 0) {
+        return -1.0;
+    }
+    self[n] = '\0';
+    char out_file[] = "/tmp/odo-bench-callgrind-XXXXXX";
+    const int fd = mkstemp(out_file);
+    if (fd < 0) {
+        return -1.0;
+    }
+    close(fd);
+    char cmd[3 * PATH_MAX];
+    snprintf(cmd, sizeof cmd,
+             "valgrind --tool=callgrind --toggle-collect=odo_app_step --callgrind-out-file=%s "
+             "'%s' --kernel >/dev/null 2>&1",
+             out_file, self);
+    const int rc = system(cmd);
+    double per_step = -1.0;
+    FILE *f = (rc == 0) ? fopen(out_file, "r") : NULL;
+    if (f != NULL) {
+        char line[512];
+        while (fgets(line, sizeof line, f) != NULL) {
+            unsigned long long total;
+            if (sscanf(line, "totals: %llu", &total) == 1 || sscanf(line, "summary: %llu", &total) == 1) {
+                per_step = (double)total / KERNEL_STEPS;
+                break;
+            }
+        }
+        fclose(f);
+    }
+    remove(out_file);
+    FILE *v = popen("valgrind --version 2>/dev/null", "r");
+    char ver[64] = "valgrind";
+    if (v != NULL) {
+        if (fgets(ver, sizeof ver, v) != NULL) {
+            ver[strcspn(ver, "\n")] = '\0';
+        }
+        pclose(v);
+    }
+    snprintf(tool, tool_len, "callgrind (%s), --toggle-collect=odo_app_step", ver);
+    return per_step;
+}
+
+int main(int argc, char **argv)
+{
+    int json = 0, quick = 0;
+    for (int i = 1; i < argc; ++i) {
+        if (strcmp(argv[i], "--kernel") == 0) {
+            return run_kernel();
+        } else if (strcmp(argv[i], "--json") == 0) {
+            json = 1;
+        } else if (strcmp(argv[i], "--quick") == 0) {
+            quick = 1;
+        } else if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
+            usage(stdout);
+            return 0;
+        } else {
+            fprintf(stderr, "odo-bench: unknown argument '%s'\n\n", argv[i]);
+            usage(stderr);
+            return 2;
+        }
+    }
+
+    fprintf(stderr, "odo-bench: fixed vs double over 1 km of mixed driving ...\n");
+    double pos = 0.0, head = 0.0;
+    const uint8_t widths[3] = {16U, 24U, 32U};
+    odo_params_t p;
+    odo_params_defaults(&p);
+    for (int run = 0; run < (quick ? 2 : 6); ++run) {
+        odo_refcheck_t r;
+        if (odo_refcheck_run(1000U + (uint64_t)run, widths[run % 3], (uint8_t)(run / 3), &p.truck[0],
+                             &p.truck[0], 1.0e6, &r) != 0) {
+            fprintf(stderr, "odo-bench: default parameters refused by the model\n");
+            return 1;
+        }
+        pos = fmax(pos, r.pos_err_mm);
+        head = fmax(head, r.heading_err_rad);
+    }
+    fprintf(stderr, "odo-bench: trig accuracy against libm ...\n");
+    double sc = 0.0, at = 0.0;
+    odo_trig_accuracy(42U, quick ? 100000U : 1000000U, &sc, &at);
+    fprintf(stderr, "odo-bench: instructions per step (callgrind) ...\n");
+    char tool[160] = "";
+    const double instr = step_instructions(tool, sizeof tool);
+
+    if (json) {
+        printf("{\"pos_err_mm_1km\": %.6g, \"heading_err_rad_1km\": %.6g, "
+               "\"sincos_max_abs_err\": %.6g, \"atan2_max_abs_err_rad\": %.6g, ",
+               pos, head, sc, at);
+        if (instr >= 0.0) {
+            printf("\"step_instructions\": %.0f, \"step_instructions_tool\": \"%s\", ", instr, tool);
+        } else {
+            printf("\"step_instructions\": null, \"step_instructions_tool\": \"valgrind not available\", ");
+        }
+        printf("\"step_instructions_trucks\": 2, \"targets\": {\"pos_err_mm_1km\": 0.1, "
+               "\"heading_err_rad_1km\": 1e-06, \"sincos_max_abs_err\": 2e-08, "
+               "\"atan2_max_abs_err_rad\": 1e-07}}\n");
+    } else {
+        printf("fixed vs double, 1 km     position %.3g mm (target <= 0.1)  heading %.3g rad (<= 1e-6)\n",
+               pos, head);
+        printf("sin/cos max abs error     %.3g (target <= 2e-8)\n", sc);
+        printf("atan2 max abs error       %.3g rad (target <= 1e-7)\n", at);
+        if (instr >= 0.0) {
+            printf("application step          %.0f instructions (2 trucks; %s)\n", instr, tool);
+        } else {
+            printf("application step          not measured (valgrind not available)\n");
+        }
+    }
+    const int ok = pos <= 0.1 && head <= 1e-6 && sc <= 2e-8 && at <= 1e-7;
+    return ok ? 0 : 1;
+}

@@ -1,0 +1,1 @@
+"""Host-side Python tools for the odometry firmware (plots, reports, log helpers)."""

@@ -1,0 +1,86 @@
+"""Plot the foundation demo: believed vs true path of a UMBmark square, cw and ccw.
+
+Reads the pose.csv files written by odo-demo and writes one PNG. A person sees at a glance that the
+firmware believes it closed the square while the uncalibrated robot did not (000 Fig. 3.3 style).
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import sys
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt
+import numpy as np
+
+
+def read_pose(path: Path) -> dict[str, np.ndarray]:
+    """Columns of an odo-demo pose.csv as float arrays, keyed by header name."""
+    with path.open(newline="") as f:
+        rows = list(csv.reader(f))
+    if len(rows) < 2:
+        raise ValueError(f"{path}: no data rows")
+    header, data = rows[0], np.array(rows[1:], dtype=float)
+    return {name: data[:, i] for i, name in enumerate(header)}
+
+
+def plot(runs: dict[str, Path], out: Path) -> None:
+    fig, (ax, zoom) = plt.subplots(1, 2, figsize=(12, 5.5))
+    colours = {"cw": "tab:blue", "ccw": "tab:red"}
+    errors: list[float] = []
+    for name, path in runs.items():
+        p = read_pose(path)
+        c = colours.get(name, "k")
+        ax.plot(p["x_mm"] / 1000, p["y_mm"] / 1000, "--", color=c, lw=1, label=f"{name}: firmware")
+        ax.plot(p["true_x_mm"] / 1000, p["true_y_mm"] / 1000, "-", color=c, lw=1.5,
+                label=f"{name}: true path")
+        ex, ey = p["true_x_mm"][-1] - p["x_mm"][-1], p["true_y_mm"][-1] - p["y_mm"][-1]
+        zoom.plot([ex], [ey], "o", color=c, ms=9, label=f"{name}: ex {ex:.0f}, ey {ey:.0f} mm")
+        errors += [abs(ex), abs(ey)]
+    ax.set(xlabel="x [m]", ylabel="y [m]", title="4 x 4 m UMBmark square, uncalibrated robot",
+           aspect="equal")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=8)
+    zoom.axhline(0, color="grey", lw=0.5)
+    zoom.axvline(0, color="grey", lw=0.5)
+    zoom.set(xlabel="ex [mm]", ylabel="ey [mm]", title="return position error (000 Eq. 3.1)",
+             aspect="equal")
+    lim = 1.3 * max([50.0, *errors])
+    zoom.set_xlim(-lim, lim)
+    zoom.set_ylim(-lim, lim)
+    zoom.grid(True, alpha=0.3)
+    zoom.legend(fontsize=8)
+    fig.tight_layout()
+    out.parent.mkdir(parents=True, exist_ok=True)
+    tmp = out.with_suffix(".tmp.png")
+    fig.savefig(tmp, dpi=110)
+    tmp.replace(out)
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__)
+    ap.add_argument("--run", action="append", default=[], metavar="NAME=POSE_CSV", required=True,
+                    help="a run to draw, e.g. cw=out/demo/cw/pose.csv (repeatable)")
+    ap.add_argument("--out", type=Path, required=True, help="PNG to write")
+    args = ap.parse_args(argv)
+    runs = {}
+    for spec in args.run:
+        name, sep, path = spec.partition("=")
+        if not sep or not path:
+            ap.error(f"--run expects NAME=PATH, got '{spec}'")
+        runs[name] = Path(path)
+    try:
+        plot(runs, args.out)
+    except (OSError, ValueError) as e:
+        print(f"odo-plot-demo: {e}", file=sys.stderr)
+        return 1
+    print(f"odo-plot-demo: wrote {args.out}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
