@@ -360,7 +360,7 @@ static bool all_zero(const uint8_t *b, size_t n)
     return acc == 0U;
 }
 
-odo_params_status_t odo_params_decode(const uint8_t *buf, size_t len, odo_params_t *out)
+odo_params_status_t odo_params_parse(const uint8_t *buf, size_t len, odo_params_t *out)
 {
     odo_params_t p;
 
@@ -421,15 +421,25 @@ odo_params_status_t odo_params_decode(const uint8_t *buf, size_t len, odo_params
     p.link.length_min_um = get_u32(&buf[OFF_LENGTH_MIN]);
     p.link.length_max_um = get_u32(&buf[OFF_LENGTH_MAX]);
 
-    /* Non-zero reserved bytes mean a writer that knows a layout we do not: refuse, never guess. */
-    if (!reserved_ok) {
-        return ODO_PARAMS_ERR_RANGE;
-    }
-    if (odo_params_validate(&p, NULL, NULL) != ODO_PARAMS_OK) {
-        return ODO_PARAMS_ERR_RANGE;
-    }
     *out = p;
-    return ODO_PARAMS_OK;
+    /* Non-zero reserved bytes mean a writer that knows a layout we do not: refuse, never guess. */
+    return reserved_ok ? ODO_PARAMS_OK : ODO_PARAMS_ERR_RANGE;
+}
+
+odo_params_status_t odo_params_decode(const uint8_t *buf, size_t len, odo_params_t *out)
+{
+    odo_params_t p;
+    if (out == NULL) {
+        return ODO_PARAMS_ERR_ARG;
+    }
+    odo_params_status_t st = odo_params_parse(buf, len, &p);
+    if (st == ODO_PARAMS_OK) {
+        st = odo_params_validate(&p, NULL, NULL);
+    }
+    if (st == ODO_PARAMS_OK) {
+        *out = p;
+    }
+    return st;
 }
 
 odo_params_status_t odo_params_load(const uint8_t *buf, size_t len, odo_params_t *out)

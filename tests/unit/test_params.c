@@ -678,6 +678,44 @@ static void test_every_status_has_distinct_text_and_crc_names_the_crc(void)
     TEST_ASSERT_NOT_NULL(odo_params_status_str((odo_params_status_t)99));
 }
 
+/// odo_params_parse reads a block whose header and CRC are good without judging its ranges, so a
+/// tool can name the bad field; decode is parse + validate and writes nothing on failure.
+static void parse_reads_out_of_range_fields_that_decode_refuses(void)
+{
+    odo_params_t p, got, untouched;
+    odo_params_defaults(&p);
+    p.truck[1].wheelbase_nm = 1U; /* below 50 mm */
+    uint8_t block[ODO_PARAMS_SIZE];
+    TEST_ASSERT_EQUAL_size_t(ODO_PARAMS_SIZE, odo_params_encode(&p, block, sizeof block));
+    TEST_ASSERT_EQUAL(ODO_PARAMS_OK, odo_params_parse(block, sizeof block, &got));
+    TEST_ASSERT_EQUAL_UINT32(1U, got.truck[1].wheelbase_nm);
+    odo_param_field_t f = ODO_PF_NONE;
+    uint8_t t = 0U;
+    TEST_ASSERT_EQUAL(ODO_PARAMS_ERR_RANGE, odo_params_validate(&got, &f, &t));
+    TEST_ASSERT_EQUAL(ODO_PF_WHEELBASE, f);
+    TEST_ASSERT_EQUAL_UINT8(1U, t);
+    memset(&untouched, 0xA5, sizeof untouched);
+    got = untouched;
+    TEST_ASSERT_EQUAL(ODO_PARAMS_ERR_RANGE, odo_params_decode(block, sizeof block, &got));
+    TEST_ASSERT_EQUAL_MEMORY(&untouched, &got, sizeof got);
+
+    /* A non-zero reserved byte: parse reports it but still hands back the fields. */
+    odo_params_defaults(&p);
+    TEST_ASSERT_EQUAL_size_t(ODO_PARAMS_SIZE, odo_params_encode(&p, block, sizeof block));
+    block[101] = 0x01U;
+    const uint32_t crc = odo_crc32(block, ODO_PARAMS_CRC_OFFSET);
+    for (unsigned i = 0U; i < 4U; ++i) {
+        block[ODO_PARAMS_CRC_OFFSET + i] = (uint8_t)(crc >> (8U * i));
+    }
+    TEST_ASSERT_EQUAL(ODO_PARAMS_ERR_RANGE, odo_params_parse(block, sizeof block, &got));
+    TEST_ASSERT_EQUAL_UINT32(p.truck[0].wheelbase_nm, got.truck[0].wheelbase_nm);
+    /* header errors leave the output alone */
+    got = untouched;
+    block[0] = 'X';
+    TEST_ASSERT_EQUAL(ODO_PARAMS_ERR_MAGIC, odo_params_parse(block, sizeof block, &got));
+    TEST_ASSERT_EQUAL_MEMORY(&untouched, &got, sizeof got);
+}
+
 int main(void)
 {
     UNITY_BEGIN();
@@ -704,5 +742,6 @@ int main(void)
     RUN_TEST(test_null_arguments_are_err_arg_never_a_crash);
     RUN_TEST(test_encode_into_too_small_a_buffer_returns_0_and_writes_nothing);
     RUN_TEST(test_every_status_has_distinct_text_and_crc_names_the_crc);
+    RUN_TEST(parse_reads_out_of_range_fields_that_decode_refuses);
     return UNITY_END();
 }

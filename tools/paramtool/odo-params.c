@@ -187,63 +187,6 @@ static uint32_t le32(const uint8_t *b)
     return (uint32_t)b[0] | ((uint32_t)b[1] << 8) | ((uint32_t)b[2] << 16) | ((uint32_t)b[3] << 24);
 }
 
-static int32_t le32s(const uint8_t *b)
-{
-    uint32_t u = le32(b);
-    int32_t s;
-    memcpy(&s, &u, sizeof s);
-    return s;
-}
-
-/// odo_params_decode writes nothing on a range error, so it cannot say which field. To name it,
-/// the block is parsed here from the header's layout table and given to odo_params_validate.
-/// The parse is proved consistent with the firmware encoder on the spot: re-encoding it must give
-/// back the input except at reserved bytes (which encode writes as 0), else this is an internal
-/// error rather than a wrong diagnosis.
-static void parse_unchecked(const uint8_t *b, odo_params_t *p)
-{
-    memset(p, 0, sizeof *p);
-    p->vehicle = b[8];
-    p->counter_bits = b[9];
-    p->heading_form = b[10];
-    p->ipec_mode = b[11];
-    p->tick_us = le32(&b[12]);
-    p->max_wheel_speed_mm_s = le32(&b[16]);
-    for (unsigned t = 0; t < ODO_TRUCKS; t++) {
-        const uint8_t *r = &b[20 + 28 * t];
-        p->truck[t].wheel_diameter_nm = le32(&r[0]);
-        p->truck[t].counts_per_rev_milli = le32(&r[4]);
-        p->truck[t].wheelbase_nm = le32(&r[8]);
-        p->truck[t].ed_q30 = le32s(&r[12]);
-        p->truck[t].eb_q30 = le32s(&r[16]);
-        p->truck[t].es_q30 = le32s(&r[20]);
-        p->truck[t].flags = r[24];
-    }
-    p->link.length_nm = le32(&b[76]);
-    p->link.hitch_offset_nm = le32(&b[80]);
-    p->link.length_bias_nm = le32s(&b[84]);
-    p->link.length_ecc_nm = le32s(&b[88]);
-    p->link.alpha_bias_bam = le32s(&b[92]);
-    p->link.beta_bias_bam = le32s(&b[96]);
-    p->link.rotary_bits = b[100];
-    p->link.stale_ticks = le16(&b[102]);
-    p->link.max_jump_bam = le32(&b[104]);
-    p->link.max_length_jump_um = le32(&b[108]);
-    p->link.length_min_um = le32(&b[112]);
-    p->link.length_max_um = le32(&b[116]);
-}
-
-static bool is_reserved_offset(unsigned off)
-{
-    for (unsigned t = 0; t < ODO_TRUCKS; t++) {
-        unsigned r = 20 + 28 * t + 25;
-        if (off >= r && off < r + 3) {
-            return true;
-        }
-    }
-    return off == 101 || (off >= 120 && off < 124);
-}
-
 static const char *field_name(odo_param_field_t f)
 {
     switch (f) {
@@ -406,43 +349,36 @@ static void diagnose(odo_params_status_t st, const uint8_t *b, size_t n, char *d
                  le32(&b[ODO_PARAMS_CRC_OFFSET]), odo_crc32(b, ODO_PARAMS_CRC_OFFSET));
         break;
     case ODO_PARAMS_ERR_RANGE: {
+        /* Header and CRC are good: parse without range checks, then let the firmware's own
+         * validator name the field. A parse that fails on range means a reserved byte: find it
+         * by re-encoding (encode writes reserved bytes as 0). */
         odo_params_t p;
-        uint8_t re[ODO_PARAMS_SIZE];
         odo_param_field_t f = ODO_PF_NONE;
         uint8_t t = 0;
-        int reserved_at = -1;
-        parse_unchecked(b, &p);
-        (void)odo_params_validate(&p, &f, &t);
-        (void)odo_params_encode(&p, re, sizeof re);
-        for (unsigned i = 0; i < ODO_PARAMS_CRC_OFFSET; i++) {
-            if (re[i] == b[i]) {
-                continue;
+        if (odo_params_parse(b, n, &p) == ODO_PARAMS_ERR_RANGE) {
+            uint8_t re[ODO_PARAMS_SIZE];
+            (void)odo_params_encode(&p, re, sizeof re);
+            for (unsigned i = 0; i < ODO_PARAMS_CRC_OFFSET; i++) {
+                if (re[i] != b[i]) {
+                    snprintf(field, fcap, "reserved");
+                    snprintf(detail, dcap, "reserved byte at offset %u is 0x%02X, must be 0", i, b[i]);
+                    break;
+                }
             }
-            if (!is_reserved_offset(i)) {
-                snprintf(detail, dcap, "internal error: tool layout disagrees with firmware at byte %u", i);
-                return;
-            }
-            if (reserved_at < 0) {
-                reserved_at = (int)i;
-            }
+            break;
         }
-        if (f != ODO_PF_NONE) {
-            if (is_truck_field(f)) {
-                snprintf(field, fcap, "truck[%u].%s", (unsigned)t, field_name(f));
-            } else {
-                snprintf(field, fcap, "%s", field_name(f));
-            }
-            if (f == ODO_PF_LENGTH_RANGE) {
-                snprintf(detail, dcap, "field %s = %" PRIu32 "/%" PRIu32 " is outside its documented range",
-                         field, p.link.length_min_um, p.link.length_max_um);
-            } else {
-                snprintf(detail, dcap, "field %s = %lld is outside its documented range", field,
-                         field_value(&p, f, t));
-            }
-        } else if (reserved_at >= 0) {
-            snprintf(field, fcap, "reserved");
-            snprintf(detail, dcap, "reserved byte at offset %d is 0x%02X, must be 0", reserved_at,
-                     b[reserved_at]);
+        (void)odo_params_validate(&p, &f, &t);
+        if (is_truck_field(f)) {
+            snprintf(field, fcap, "truck[%u].%s", (unsigned)t, field_name(f));
+        } else {
+            snprintf(field, fcap, "%s", field_name(f));
+        }
+        if (f == ODO_PF_LENGTH_RANGE) {
+            snprintf(detail, dcap, "field %s = %" PRIu32 "/%" PRIu32 " is outside its documented range",
+                     field, p.link.length_min_um, p.link.length_max_um);
+        } else {
+            snprintf(detail, dcap, "field %s = %lld is outside its documented range", field,
+                     field_value(&p, f, t));
         }
         break;
     }

@@ -145,7 +145,13 @@ odo_params_status_t odo_params_validate(const odo_params_t *p, odo_param_field_t
 /// cap < ODO_PARAMS_SIZE or an argument is NULL. Does not validate (tests need to write bad blocks).
 size_t odo_params_encode(const odo_params_t *p, uint8_t *buf, size_t cap);
 
-/// Parse and check header, length and CRC, then range-check. *out is written only on ODO_PARAMS_OK.
+/// Check header, length and CRC and read every field as stored, without range checks, so tools
+/// can name an offending field with odo_params_validate. Returns ODO_PARAMS_OK with *out filled;
+/// ODO_PARAMS_ERR_RANGE with *out filled iff a reserved byte is non-zero; any other error with
+/// *out untouched. Reads only the first ODO_PARAMS_SIZE bytes of a larger region.
+odo_params_status_t odo_params_parse(const uint8_t *buf, size_t len, odo_params_t *out);
+
+/// odo_params_parse, then odo_params_validate. *out is written only on ODO_PARAMS_OK.
 odo_params_status_t odo_params_decode(const uint8_t *buf, size_t len, odo_params_t *out);
 
 /// Boot-time load: decode; on any failure fill *out with the defaults. Returns the decode status, so
