@@ -28,6 +28,18 @@ static odo_model_t model_of(const odo_truck_params_t *tp, uint8_t bits, uint8_t 
     return m;
 }
 
+/// A truck at the origin, heading +x, whose first reading (left, right) sets the counter baseline.
+static odo_truck_t truck_at_origin(const odo_model_t *m, uint32_t left, uint32_t right, uint8_t bits)
+{
+    odo_truck_t t;
+    const odo_pose_t origin = {0, 0, 0U};
+    odo_truck_reset(&t, &origin);
+    odo_step_t st;
+    odo_truck_step(&t, m, left, right, bits, &st);
+    TEST_ASSERT_FALSE(st.jump);
+    return t;
+}
+
 static double cm_mm(const odo_truck_params_t *tp)
 {
     return M_PI * (tp->wheel_diameter_nm * 1e-6 / (tp->es_q30 / 1073741824.0)) /
@@ -87,12 +99,9 @@ static void straight_line_keeps_heading_and_lateral_position_exact(void)
 {
     const odo_truck_params_t tp = labmate();
     const odo_model_t m = model_of(&tp, 24U, ODO_HEADING_MIDPOINT);
-    odo_truck_t t;
-    const odo_pose_t origin = {0, 0, 0U};
-    odo_truck_reset(&t, &origin);
-    odo_step_t st;
     uint32_t c = 0xFFF000U; /* starts close to the 24-bit wrap */
-    odo_truck_step(&t, &m, c, c, 24U, &st);
+    odo_truck_t t = truck_at_origin(&m, c, c, 24U);
+    odo_step_t st;
     for (int i = 0; i < 5000; ++i) {
         c = (c + 661U) & 0xFFFFFFU;
         odo_truck_step(&t, &m, c, c, 24U, &st);
@@ -107,11 +116,8 @@ static void on_the_spot_turn_changes_heading_not_position(void)
 {
     const odo_truck_params_t tp = labmate();
     const odo_model_t m = model_of(&tp, 24U, ODO_HEADING_MIDPOINT);
-    odo_truck_t t;
-    const odo_pose_t origin = {0, 0, 0U};
-    odo_truck_reset(&t, &origin);
+    odo_truck_t t = truck_at_origin(&m, 0U, 0U, 24U);
     odo_step_t st;
-    odo_truck_step(&t, &m, 0U, 0U, 24U, &st);
     int64_t n = 0;
     for (int i = 1; i <= 250; ++i) { /* 250 ticks of +-300 counts */
         n += 300;
@@ -133,11 +139,8 @@ static double arc_end_error_mm(uint8_t form)
     const double k = cm_mm(&tp), b = 340.0;
     const double dth = (dr - dl) * k / b, u = 0.5 * (dl + dr) * k;
     const int ticks = (int)floor((M_PI / 2.0) / dth);
-    odo_truck_t t;
-    const odo_pose_t origin = {0, 0, 0U};
-    odo_truck_reset(&t, &origin);
+    odo_truck_t t = truck_at_origin(&m, 0U, 0U, 32U);
     odo_step_t st;
-    odo_truck_step(&t, &m, 0U, 0U, 32U, &st);
     for (int i = 1; i <= ticks; ++i) {
         odo_truck_step(&t, &m, (uint32_t)(i * dl), (uint32_t)(i * dr), 32U, &st);
     }
@@ -163,11 +166,8 @@ static void unequal_wheels_are_corrected_per_eq_6_35(void)
     odo_truck_params_t tp = labmate();
     tp.ed_q30 = Q30(1.01);
     const odo_model_t m = model_of(&tp, 24U, ODO_HEADING_MIDPOINT);
-    odo_truck_t t;
-    const odo_pose_t origin = {0, 0, 0U};
-    odo_truck_reset(&t, &origin);
+    odo_truck_t t = truck_at_origin(&m, 0U, 0U, 24U);
     odo_step_t st;
-    odo_truck_step(&t, &m, 0U, 0U, 24U, &st);
     odo_truck_step(&t, &m, 1000U, 1000U, 24U, &st);
     const double ed = tp.ed_q30 / 1073741824.0;
     const double want = 1000.0 * cm_mm(&tp) * (2.0 / (1.0 / ed + 1.0) - 2.0 / (ed + 1.0)) / 340.0;
@@ -181,11 +181,8 @@ static void implausible_counter_jump_is_flagged_not_integrated(void)
 {
     const odo_truck_params_t tp = labmate();
     const odo_model_t m = model_of(&tp, 24U, ODO_HEADING_MIDPOINT);
-    odo_truck_t t;
-    const odo_pose_t origin = {0, 0, 0U};
-    odo_truck_reset(&t, &origin);
+    odo_truck_t t = truck_at_origin(&m, 100U, 100U, 24U);
     odo_step_t st;
-    odo_truck_step(&t, &m, 100U, 100U, 24U, &st);
     odo_truck_step(&t, &m, 100U + m.max_counts, 100U, 24U, &st); /* exactly at the limit: fine */
     TEST_ASSERT_FALSE(st.jump);
     const odo_pose_t before = t.pose;
@@ -206,11 +203,8 @@ static void inverted_encoders_count_forward(void)
     odo_truck_params_t tp = labmate();
     tp.flags = ODO_TRUCK_INVERT_LEFT;
     const odo_model_t m = model_of(&tp, 16U, ODO_HEADING_MIDPOINT);
-    odo_truck_t t;
-    const odo_pose_t origin = {0, 0, 0U};
-    odo_truck_reset(&t, &origin);
+    odo_truck_t t = truck_at_origin(&m, 5U, 5U, 16U);
     odo_step_t st;
-    odo_truck_step(&t, &m, 5U, 5U, 16U, &st);
     odo_truck_step(&t, &m, ts_wrap_counter(5 - 400, 16U), 405U, 16U, &st);
     TEST_ASSERT_EQUAL_INT32(400, st.delta[0]);
     TEST_ASSERT_EQUAL_INT32(400, st.delta[1]);
