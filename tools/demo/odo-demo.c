@@ -14,6 +14,7 @@
 #include <string.h>
 #include <sys/stat.h>
 
+#include "candump.h"
 #include "hal_test.h"
 #include "odo/odo_app.h"
 #include "odo_loop.h"
@@ -25,16 +26,6 @@ static void usage(FILE *f)
     fprintf(f, "usage: odo-demo --out DIR [--direction cw|ccw]\n"
                "Runs a 4 x 4 m UMBmark square through the firmware step and writes DIR/pose.csv and\n"
                "DIR/output.log (candump -l). Prints the return error (000 Eq. 3.1).\n");
-}
-
-static void write_frame(FILE *f, uint64_t t_us, const odo_can_frame_t *fr)
-{
-    fprintf(f, "(%llu.%06llu) vcan0 %03X#", (unsigned long long)(t_us / 1000000U),
-            (unsigned long long)(t_us % 1000000U), (unsigned)fr->id);
-    for (uint8_t i = 0U; i < fr->dlc; ++i) {
-        fprintf(f, "%02X", fr->data[i]);
-    }
-    fputc('\n', f);
 }
 
 int main(int argc, char **argv)
@@ -113,7 +104,7 @@ int main(int argc, char **argv)
     hal_test_set_wheel(&hal, 0U, 0U, 0U, 24U, seq++);
     odo_loop_tick(&app, &hal, &out);
     for (uint32_t f = 0U; f < hal.n_tx; ++f) {
-        write_frame(lf, t_us, &hal.tx[f]);
+        odo_candump_write(lf, t_us, "vcan0", &hal.tx[f]);
     }
     fprintf(pf, "0.000,0.0000,0.0000,0.000000,0.0000,0.0000,0.000000\n");
     t_us += p.tick_us;
@@ -143,7 +134,7 @@ int main(int argc, char **argv)
             hal.n_tx = 0U;
             odo_loop_tick(&app, &hal, &out);
             for (uint32_t f = 0U; f < hal.n_tx; ++f) {
-                write_frame(lf, t_us, &hal.tx[f]);
+                odo_candump_write(lf, t_us, "vcan0", &hal.tx[f]);
             }
             const odo_pose_t *pose = &out.pose[0];
             fprintf(pf, "%.3f,%.4f,%.4f,%.6f,%.4f,%.4f,%.6f\n", t_us * 1e-6, pose->x_mm_q32 / 4294967296.0,
