@@ -10,6 +10,7 @@
 static odo_app_t app;
 static hal_ctx_t hal;
 static odo_tick_output_t out;
+static odo_tick_input_t loop_in;
 
 static void boot(uint8_t vehicle)
 {
@@ -24,10 +25,10 @@ START_TEST(loop_reads_counters_through_the_hal_and_publishes_frames)
 {
     boot(ODO_VEHICLE_SINGLE);
     hal_test_set_wheel(&hal, 0U, 0xFFFFF0U, 0xFFFFF0U, 24U, 0U);
-    odo_loop_tick(&app, &hal, &out);
+    odo_loop_tick(&app, &hal, &loop_in, &out);
     hal.now_us = 40000U;
     hal_test_set_wheel(&hal, 0U, 0x000010U, 0x000010U, 24U, 1U); /* across the 24-bit wrap */
-    odo_loop_tick(&app, &hal, &out);
+    odo_loop_tick(&app, &hal, &loop_in, &out);
     ck_assert_uint_eq(6U, hal.n_tx); /* 2 ticks x (pose xy, pose theta, status) */
     odo_msg_pose_xy_t xy;
     uint8_t truck;
@@ -40,7 +41,7 @@ END_TEST
 START_TEST(absent_sample_is_reported_as_missing)
 {
     boot(ODO_VEHICLE_SINGLE);
-    odo_loop_tick(&app, &hal, &out); /* nothing set */
+    odo_loop_tick(&app, &hal, &loop_in, &out); /* nothing set */
     ck_assert(out.faults & ODO_FAULT_WHEEL_MISSING_A);
 }
 END_TEST
@@ -51,13 +52,13 @@ START_TEST(refused_sends_are_counted_and_the_tick_is_not_lost)
     hal.refuse_tx = 4U; /* like ENOBUFS on a busy bus */
     hal_test_set_wheel(&hal, 0U, 0U, 0U, 24U, 0U);
     hal_test_set_wheel(&hal, 1U, 0U, 0U, 24U, 0U);
-    odo_loop_tick(&app, &hal, &out);
+    odo_loop_tick(&app, &hal, &loop_in, &out);
     ck_assert_uint_eq(4U, app.tx_dropped);
     ck_assert_uint_eq(2U, hal.n_tx);
     ck_assert_uint_eq(1U, app.ticks);
     hal_test_set_wheel(&hal, 0U, 50U, 50U, 24U, 1U);
     hal_test_set_wheel(&hal, 1U, 50U, 50U, 24U, 1U);
-    odo_loop_tick(&app, &hal, &out);
+    odo_loop_tick(&app, &hal, &loop_in, &out);
     ck_assert_uint_eq(8U, hal.n_tx);
     ck_assert_uint_eq(2U, app.ticks);
 }

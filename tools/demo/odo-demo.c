@@ -83,6 +83,7 @@ int main(int argc, char **argv)
     static odo_app_t app;
     static hal_ctx_t hal;
     static odo_tick_output_t out;
+    static odo_tick_input_t loop_in;
     odo_app_init_params(&app, &p);
     hal_test_init(&hal, 1U, false);
     odo_ref_t real;
@@ -102,7 +103,7 @@ int main(int argc, char **argv)
     fprintf(pf, "t_s,x_mm,y_mm,theta_deg,true_x_mm,true_y_mm,true_theta_deg\n");
     /* The robot boots at rest: the first sample only sets the counter baseline. */
     hal_test_set_wheel(&hal, 0U, 0U, 0U, 24U, seq++);
-    odo_loop_tick(&app, &hal, &out);
+    odo_loop_tick(&app, &hal, &loop_in, &out);
     for (uint32_t f = 0U; f < hal.n_tx; ++f) {
         odo_candump_write(lf, t_us, "vcan0", &hal.tx[f]);
     }
@@ -132,7 +133,7 @@ int main(int argc, char **argv)
             hal_test_set_wheel(&hal, 0U, (uint32_t)((uint64_t)cl & 0xFFFFFFU),
                                (uint32_t)((uint64_t)cr & 0xFFFFFFU), 24U, seq++);
             hal.n_tx = 0U;
-            odo_loop_tick(&app, &hal, &out);
+            odo_loop_tick(&app, &hal, &loop_in, &out);
             for (uint32_t f = 0U; f < hal.n_tx; ++f) {
                 odo_candump_write(lf, t_us, "vcan0", &hal.tx[f]);
             }
