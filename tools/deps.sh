@@ -9,6 +9,7 @@ APT_PACKAGES=(
   gcc-arm-none-eabi libnewlib-arm-none-eabi binutils-arm-none-eabi  # Cortex-M4 cross build
   python3 python3-venv                                             # host tools, pytest
   valgrind                                                         # odo-bench instruction counts
+  libjansson-dev                                                   # host_sim robot/scenario JSON
 )
 
 missing=()
