@@ -195,6 +195,7 @@ int sim_run(const sim_run_config_t *cfg, sim_tick_fn on_tick, void *user, sim_re
         ret->x_calc_mm = q32_mm(est->x_mm_q32);
         ret->y_calc_mm = q32_mm(est->y_mm_q32);
         ret->theta_calc_deg = q64_rad(est->heading_q64) * 180.0 / M_PI;
+        ret->t_end_s = sim_world_time_s(&st->world);
         sim_return_errors(ret);
     }
     free(st);

@@ -18,7 +18,7 @@ def run(*args: str, check: bool = False) -> subprocess.CompletedProcess[str]:
                           timeout=300)
 
 
-@pytest.mark.parametrize("tool", ["odo-demo", "odo-bench", "odo-params", "odo-canvec"])
+@pytest.mark.parametrize("tool", ["odo-demo", "odo-bench", "odo-params", "odo-canvec", "odo-sim"])
 def test_every_cli_has_help(tool: str) -> None:
     r = run(BIN / tool, "--help")
     assert r.returncode == 0, r.stderr
@@ -82,6 +82,10 @@ def test_bench_prints_the_foundation_figures_within_targets() -> None:
     assert fig["atan2_max_abs_err_rad"] <= 1e-7
     assert fig["step_instructions"] is None or 100 < fig["step_instructions"] < 100000
     assert "callgrind" in fig["step_instructions_tool"] or fig["step_instructions"] is None
+    # host_sim issue: the 10-run UMBmark set at 1 ms physics with the firmware in the loop
+    assert fig["sim_umbmark_10runs_s"] > 0 and fig["sim_seconds"] > 800
+    factor = fig["sim_seconds"] / fig["sim_umbmark_10runs_s"]
+    assert fig["sim_realtime_factor"] == pytest.approx(factor, rel=0.01)
 
 
 def test_bench_rejects_unknown_arguments() -> None:

@@ -11,11 +11,14 @@
 #include <string.h>
 #include <sys/types.h>
 #include <sys/wait.h>
+#include <time.h>
 #include <unistd.h>
 
 #include "odo/odo_app.h"
 #include "odo_refcheck.h"
 #include "odo_synth.h"
+#include "robot.h"
+#include "sil.h"
 #include "trig_accuracy.h"
 
 #define KERNEL_STEPS 20000U
@@ -31,6 +34,10 @@ static void usage(FILE *f)
             "  sincos_max_abs_err, atan2_max_abs_err_rad  vs libm over 10^6 random inputs + edges\n"
             "  step_instructions                    x86-64 instructions per 40 ms application\n"
             "                                       step for two trucks, counted by callgrind\n"
+            "  sim_umbmark_10runs_s                 wall seconds for the 10-run UMBmark set of the\n"
+            "                                       000 s. 4.6.2 robot at 1 ms physics, firmware in\n"
+            "                                       the loop (target < 1 s on one core)\n"
+            "  sim_realtime_factor                  simulated seconds per wall second in that set\n"
             "  --json   one JSON object on stdout (progress goes to stderr)\n"
             "  --quick  fewer samples (for smoke tests; figures are then indicative only)\n");
 }
@@ -119,6 +126,47 @@ static double step_instructions(char *tool, size_t tool_len)
     return per_step;
 }
 
+static double now_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + ts.tv_nsec * 1e-9;
+}
+
+/// The 10-run UMBmark set (5 cw, 5 ccw) of the 000 s. 4.6.2 robot (b 337 vs 340 mm, Ed 0.9985,
+/// 0-1 mm roughness). Returns wall seconds, and simulated seconds in *sim_s; -1 on error.
+static double sim_umbmark_10runs(double *sim_s)
+{
+    static sim_robot_t robot;
+    static sim_scenario_t sc;
+    char err[256];
+    if (sim_robot_default(SIM_VEHICLE_LABMATE, &robot) != 0) {
+        return -1.0;
+    }
+    sim_scenario_none(&sc);
+    if (sim_scenario_set(&sc, "eb", "value", 1U, 337.0 / 340.0, err, sizeof err) != 0 ||
+        sim_scenario_set(&sc, "ed", "value", 1U, 0.9985, err, sizeof err) != 0 ||
+        sim_scenario_set(&sc, "roughness", NULL, 1U, 0.0, err, sizeof err) != 0) {
+        fprintf(stderr, "odo-bench: %s\n", err);
+        return -1.0;
+    }
+    *sim_s = 0.0;
+    const double t0 = now_s();
+    for (int d = 0; d < 2; ++d) {
+        for (unsigned k = 0; k < 5U; ++k) {
+            sim_run_config_t cfg = {.robot = &robot, .scenario = &sc, .experiment = "umbmark", .ccw = d,
+                                    .bumps = -1, .bump_height_mm = 10.0, .seed = 100U + k, .run_index = k};
+            sim_return_t ret;
+            if (sim_run(&cfg, NULL, NULL, &ret, err, sizeof err) != 0) {
+                fprintf(stderr, "odo-bench: %s\n", err);
+                return -1.0;
+            }
+            *sim_s += ret.t_end_s;
+        }
+    }
+    return now_s() - t0;
+}
+
 int main(int argc, char **argv)
 {
     int json = 0, quick = 0;
@@ -160,6 +208,9 @@ int main(int argc, char **argv)
     fprintf(stderr, "odo-bench: instructions per step (callgrind) ...\n");
     char tool[160] = "";
     const double instr = step_instructions(tool, sizeof tool);
+    fprintf(stderr, "odo-bench: 10-run UMBmark in the simulator ...\n");
+    double sim_s = 0.0;
+    const double sim_wall = sim_umbmark_10runs(&sim_s);
 
     if (json) {
         printf("{\"pos_err_mm_1km\": %.6g, \"heading_err_rad_1km\": %.6g, "
@@ -170,9 +221,16 @@ int main(int argc, char **argv)
         } else {
             printf("\"step_instructions\": null, \"step_instructions_tool\": \"valgrind not available\", ");
         }
-        printf("\"step_instructions_trucks\": 2, \"targets\": {\"pos_err_mm_1km\": 0.1, "
+        printf("\"step_instructions_trucks\": 2, ");
+        if (sim_wall >= 0.0) {
+            printf("\"sim_umbmark_10runs_s\": %.4f, \"sim_realtime_factor\": %.0f, \"sim_seconds\": %.1f, ",
+                   sim_wall, sim_s / sim_wall, sim_s);
+        } else {
+            printf("\"sim_umbmark_10runs_s\": null, \"sim_realtime_factor\": null, ");
+        }
+        printf("\"targets\": {\"pos_err_mm_1km\": 0.1, "
                "\"heading_err_rad_1km\": 1e-06, \"sincos_max_abs_err\": 2e-08, "
-               "\"atan2_max_abs_err_rad\": 1e-07}}\n");
+               "\"atan2_max_abs_err_rad\": 1e-07, \"sim_umbmark_10runs_s\": 1.0}}\n");
     } else {
         printf("fixed vs double, 1 km     position %.3g mm (target <= 0.1)  heading %.3g rad (<= 1e-6)\n",
                pos, head);
@@ -182,6 +240,10 @@ int main(int argc, char **argv)
             printf("application step          %.0f instructions (2 trucks; %s)\n", instr, tool);
         } else {
             printf("application step          not measured (valgrind not available)\n");
+        }
+        if (sim_wall >= 0.0) {
+            printf("simulator, 10-run UMBmark  %.3f s wall for %.0f s simulated (x%.0f real time; target < 1 s)\n",
+                   sim_wall, sim_s, sim_s / sim_wall);
         }
     }
     const int ok = pos <= 0.1 && head <= 1e-6 && sc <= 2e-8 && at <= 1e-7;
