@@ -189,15 +189,6 @@ static int write_summary(const char *dir, const char *experiment, const char *ve
     return fclose(f) == 0 ? 0 : -1;
 }
 
-/// Seed of one run: the base seed mixed with direction and run number (splitmix64 finaliser).
-static uint64_t run_seed(uint64_t base, int ccw, unsigned run)
-{
-    uint64_t z = base * 0x9E3779B97F4A7C15ULL + (uint64_t)ccw * 0xBF58476D1CE4E5B9ULL + run;
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBULL;
-    return z ^ (z >> 31);
-}
-
 int main(int argc, char **argv)
 {
     const char *experiment = NULL, *vehicle_name = NULL, *scenario_path = NULL, *robot_path = NULL,
@@ -349,7 +340,7 @@ int main(int argc, char **argv)
                 const sim_run_config_t cfg = {
                     .robot = &robot, .scenario = &scenario, .experiment = experiment, .ccw = d,
                     .bumps = (int)bumps, .bump_height_mm = 10.0, .ipec = ipec,
-                    .seed = run_seed(seed, d, k), .run_index = k,
+                    .seed = sim_run_seed(seed, d, k), .run_index = k,
                 };
                 if (sim_run(&cfg, on_tick, &rf, &rets[n_ret], err, sizeof err) != 0) {
                     fprintf(stderr, "odo-sim: %s\n", err);

@@ -51,4 +51,8 @@ typedef void (*sim_tick_fn)(void *user, const sim_tick_t *tick);
 int sim_run(const sim_run_config_t *cfg, sim_tick_fn on_tick, void *user, sim_return_t *ret,
             char *err, size_t errlen);
 
+/// The seed of run `run` (0-based) of direction `ccw` for a base seed: odo-sim and libodosim
+/// use it so a run is reproducible from either.
+uint64_t sim_run_seed(uint64_t base, int ccw, unsigned run);
+
 #endif

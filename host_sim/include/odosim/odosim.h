@@ -1,0 +1,82 @@
+/// libodosim: the simulator as a library, for tools that re-simulate many candidate effect
+/// settings in memory (the sim-to-real diagnosis) without touching the disk. Every run is the same
+/// software-in-the-loop run odo-sim makes (same seeds, same bits), but its per-tick results land
+/// in caller-provided arrays instead of files.
+///
+/// C ABI, plain types only, so Python can call it through ctypes. Thread safety: a setup may be
+/// shared by concurrent odosim_run calls (it is only read); everything else is per call.
+/// Errors: functions return 0 / non-NULL on success, and -1 / NULL with a message in err.
+#ifndef ODOSIM_H
+#define ODOSIM_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define ODOSIM_API_VERSION 1
+
+/// A robot (what the firmware believes) plus a scenario (the truth's effects).
+typedef struct odosim_setup odosim_setup_t;
+
+/// One row per firmware tick (40 ms).
+typedef struct {
+    double   t_s;
+    double   truth[2][3];      ///< per truck: x_mm, y_mm, theta_rad (unwrapped), true
+    double   est[2][3];        ///< per truck: the firmware's published pose (theta in [-pi, pi))
+    double   link[3];          ///< true alpha_rad, beta_rad, l_mm (clapper/set; 0 for a labmate)
+    uint32_t counts[2][2];     ///< raw counter values the firmware read, [truck][left, right]
+    uint32_t faults;           ///< ODO_FAULT_* bits of the tick
+    uint32_t bump_events;      ///< discrete bumps first touched during this tick
+} odosim_tick_row_t;
+
+typedef struct {
+    double   x_abs_mm, y_abs_mm, theta_abs_deg;    ///< true return pose of truck A
+    double   x_calc_mm, y_calc_mm, theta_calc_deg; ///< the firmware's
+    double   ex_mm, ey_mm, etheta_deg;             ///< 000 Eq. 3.1
+    double   t_end_s;
+    size_t   n_ticks;                              ///< ticks run (rows beyond capacity not stored)
+} odosim_result_t;
+
+/// ODOSIM_API_VERSION of the loaded library.
+int odosim_api_version(void);
+
+/// Read a robot description and a scenario from files (host_sim/robots, host_sim/scenarios).
+odosim_setup_t *odosim_setup_load(const char *robot_path, const char *scenario_path, char *err,
+                                  size_t errlen);
+
+/// The same from JSON text.
+odosim_setup_t *odosim_setup_parse(const char *robot_json, const char *scenario_json, char *err,
+                                   size_t errlen);
+
+/// Switch an effect on and set one of its parameters (NULL param: just enable); truck_mask bit 0
+/// is truck A, bit 1 truck B. For sweeping candidates without files.
+int odosim_setup_set(odosim_setup_t *s, const char *effect, const char *param, unsigned truck_mask,
+                     double value, char *err, size_t errlen);
+
+/// Switch every effect off again (keeps the robot).
+void odosim_setup_clear(odosim_setup_t *s);
+
+void odosim_setup_free(odosim_setup_t *s);
+
+/// The seed odo-sim gives run `run` (0-based) of direction `ccw` for a base seed, so a library
+/// run reproduces a CLI run exactly.
+uint64_t odosim_run_seed(uint64_t base_seed, int ccw, unsigned run);
+
+/// One run of an experiment ("umbmark", "umbmark-ext", "straight-36m", "rect-7x4"); bumps < 0 for
+/// the experiment's default; ipec 0/1. Writes up to `capacity` rows (rows may be NULL). Returns 0.
+int odosim_run(const odosim_setup_t *s, const char *experiment, int ccw, int bumps, int ipec,
+               uint64_t seed, unsigned run_index, odosim_tick_row_t *rows, size_t capacity,
+               odosim_result_t *result, char *err, size_t errlen);
+
+/// The effects catalog as a JSON document (malloc'd; release with odosim_free), or NULL.
+char *odosim_effects_json(void);
+
+void odosim_free(void *p);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,147 @@
+/// libodosim (host_sim/include/odosim/odosim.h) over the SIL runner.
+#include "odosim/odosim.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "effects.h"
+#include "robot.h"
+#include "sil.h"
+
+struct odosim_setup {
+    sim_robot_t    robot;
+    sim_scenario_t scenario;
+};
+
+int odosim_api_version(void) { return ODOSIM_API_VERSION; }
+
+odosim_setup_t *odosim_setup_load(const char *robot_path, const char *scenario_path, char *err, size_t errlen)
+{
+    odosim_setup_t *s = calloc(1, sizeof *s);
+    if (s == NULL) {
+        snprintf(err, errlen, "out of memory");
+        return NULL;
+    }
+    if (sim_robot_parse_file(robot_path, &s->robot, err, errlen) != 0 ||
+        sim_scenario_parse_file(scenario_path, &s->scenario, err, errlen) != 0) {
+        free(s);
+        return NULL;
+    }
+    return s;
+}
+
+odosim_setup_t *odosim_setup_parse(const char *robot_json, const char *scenario_json, char *err, size_t errlen)
+{
+    odosim_setup_t *s = calloc(1, sizeof *s);
+    if (s == NULL) {
+        snprintf(err, errlen, "out of memory");
+        return NULL;
+    }
+    if (sim_robot_parse_string(robot_json, "<robot>", &s->robot, err, errlen) != 0 ||
+        sim_scenario_parse_string(scenario_json, "<scenario>", &s->scenario, err, errlen) != 0) {
+        free(s);
+        return NULL;
+    }
+    return s;
+}
+
+int odosim_setup_set(odosim_setup_t *s, const char *effect, const char *param, unsigned truck_mask,
+                     double value, char *err, size_t errlen)
+{
+    return sim_scenario_set(&s->scenario, effect, param, truck_mask, value, err, errlen);
+}
+
+void odosim_setup_clear(odosim_setup_t *s)
+{
+    const uint64_t seed = s->scenario.seed;
+    sim_scenario_none(&s->scenario);
+    s->scenario.seed = seed;
+}
+
+void odosim_setup_free(odosim_setup_t *s) { free(s); }
+
+uint64_t odosim_run_seed(uint64_t base_seed, int ccw, unsigned run) { return sim_run_seed(base_seed, ccw, run); }
+
+typedef struct {
+    odosim_tick_row_t *rows;
+    size_t             capacity;
+    size_t             n;
+} collect_t;
+
+static void collect(void *user, const sim_tick_t *tk)
+{
+    collect_t *c = user;
+    if (c->rows != NULL && c->n < c->capacity) {
+        odosim_tick_row_t *r = &c->rows[c->n];
+        memset(r, 0, sizeof *r);
+        r->t_s = tk->t_s;
+        for (unsigned t = 0; t < 2; ++t) {
+            const odo_pose_t *p = &tk->output->pose[t];
+            r->truth[t][0] = tk->truth[t].x_mm;
+            r->truth[t][1] = tk->truth[t].y_mm;
+            r->truth[t][2] = tk->truth[t].theta_rad;
+            r->est[t][0] = (double)p->x_mm_q32 / 4294967296.0;
+            r->est[t][1] = (double)p->y_mm_q32 / 4294967296.0;
+            r->est[t][2] = (double)(int32_t)odo_heading_bam(p) * (M_PI / 2147483648.0);
+            r->counts[t][0] = tk->input->wheel[t].left_raw;
+            r->counts[t][1] = tk->input->wheel[t].right_raw;
+        }
+        r->link[0] = tk->link.alpha_rad;
+        r->link[1] = tk->link.beta_rad;
+        r->link[2] = tk->link.length_mm;
+        r->faults = tk->output->faults;
+        r->bump_events = (uint32_t)tk->n_events;
+    }
+    c->n++;
+}
+
+int odosim_run(const odosim_setup_t *s, const char *experiment, int ccw, int bumps, int ipec, uint64_t seed,
+               unsigned run_index, odosim_tick_row_t *rows, size_t capacity, odosim_result_t *result,
+               char *err, size_t errlen)
+{
+    if (s == NULL || experiment == NULL || result == NULL) {
+        snprintf(err, errlen, "NULL argument");
+        return -1;
+    }
+    const sim_run_config_t cfg = {.robot = &s->robot, .scenario = &s->scenario, .experiment = experiment,
+                                  .ccw = ccw ? 1 : 0, .bumps = bumps, .bump_height_mm = 10.0,
+                                  .ipec = ipec ? 1 : 0, .seed = seed, .run_index = run_index};
+    collect_t c = {rows, capacity, 0};
+    sim_return_t ret;
+    if (sim_run(&cfg, collect, &c, &ret, err, errlen) != 0) {
+        return -1;
+    }
+    memset(result, 0, sizeof *result);
+    result->x_abs_mm = ret.x_abs_mm;
+    result->y_abs_mm = ret.y_abs_mm;
+    result->theta_abs_deg = ret.theta_abs_deg;
+    result->x_calc_mm = ret.x_calc_mm;
+    result->y_calc_mm = ret.y_calc_mm;
+    result->theta_calc_deg = ret.theta_calc_deg;
+    result->ex_mm = ret.ex_mm;
+    result->ey_mm = ret.ey_mm;
+    result->etheta_deg = ret.etheta_deg;
+    result->t_end_s = ret.t_end_s;
+    result->n_ticks = c.n;
+    return 0;
+}
+
+char *odosim_effects_json(void)
+{
+    char *buf = NULL;
+    size_t len = 0;
+    FILE *f = open_memstream(&buf, &len);
+    if (f == NULL) {
+        return NULL;
+    }
+    const int rc = sim_effects_write_json(f);
+    if (fclose(f) != 0 || rc != 0) {
+        free(buf);
+        return NULL;
+    }
+    return buf;
+}
+
+void odosim_free(void *p) { free(p); }
