@@ -11,7 +11,8 @@
 #include "odo/odo_fx.h"
 #include "odo_loop.h"
 
-#define MAX_RUN_S 3600.0 /* a run that has not finished after an hour is a bug, not a result */
+#define MAX_RUN_S 3600.0
+#define B_BUMP_MARGIN_MM 100.0 /* a bump this close to where B stops would be met while turning */ /* a run that has not finished after an hour is a bug, not a result */
 
 /// Everything one run needs; large, so allocated once per run.
 typedef struct {
@@ -22,16 +23,21 @@ typedef struct {
     odo_tick_output_t out;
     sim_program_t     prog;
     sim_follower_t    follow;
+    sim_clapper_follower_t follow2; ///< clapper: both trucks
 } sil_state_t;
 
 static double q32_mm(int64_t v) { return (double)v / 4294967296.0; }
 static double q64_rad(uint64_t h) { return (double)(int32_t)(uint32_t)((h + 0x80000000ULL) >> 32) * (M_PI / 2147483648.0); }
 
-/// Where truck B's wheel meets a floor bump placed at path distance p: B runs the same path l
-/// behind A, so forward legs reach it l later and backward legs (B leading) l earlier.
-static double travel_of_b(const sim_program_t *prog, double p, double l)
+/// Where truck B's wheel meets a floor bump placed at path distance p (*at, in B's wheel travel):
+/// B runs the same path l behind A, so forward legs reach it l later and backward legs (B leading)
+/// l earlier. A leg is a run of LINE/ARC segments between stops (PAUSE, TURN); B starts and ends
+/// every leg l from A, so it never reaches a bump that lies between the two trucks at the leg's
+/// end (forward: within l of the end) or start (backward: within l of the start): false then
+/// (also within B_BUMP_MARGIN_MM of that, where B would stop on it).
+static bool travel_of_b(const sim_program_t *prog, double p, double l, double *at)
 {
-    double at = 0.0;
+    double pos = 0.0, leg_start = 0.0;
     for (size_t i = 0; i < prog->n_seg; ++i) {
         const sim_segment_t *s = &prog->seg[i];
         double len = 0.0;
@@ -39,23 +45,34 @@ static double travel_of_b(const sim_program_t *prog, double p, double l)
             len = hypot(s->x1_mm - s->x0_mm, s->y1_mm - s->y0_mm);
         } else if (s->kind == SIM_SEG_ARC) {
             len = fabs(s->sweep_rad) * s->radius_mm;
+        } else {
+            leg_start = pos;
+            continue;
         }
-        if (len > 0.0 && p < at + len) {
-            return (s->kind == SIM_SEG_LINE && s->speed_mm_s < 0.0) ? p - l : p + l;
+        if (p < pos + len) {
+            double leg_end = pos + len;
+            for (size_t j = i + 1; j < prog->n_seg && (prog->seg[j].kind == SIM_SEG_LINE ||
+                                                       prog->seg[j].kind == SIM_SEG_ARC); ++j) {
+                const sim_segment_t *n = &prog->seg[j];
+                leg_end += n->kind == SIM_SEG_LINE ? hypot(n->x1_mm - n->x0_mm, n->y1_mm - n->y0_mm)
+                                                   : fabs(n->sweep_rad) * n->radius_mm;
+            }
+            if (s->kind == SIM_SEG_LINE && s->speed_mm_s < 0.0) {
+                *at = p - l;
+                return p >= leg_start + l + B_BUMP_MARGIN_MM;
+            }
+            *at = p + l;
+            return p <= leg_end - l - B_BUMP_MARGIN_MM;
         }
-        at += len;
+        pos += len;
     }
-    return p + l;
+    return false;
 }
 
 static int setup(sil_state_t *st, const sim_run_config_t *cfg, char *err, size_t errlen)
 {
     const sim_robot_t *r = cfg->robot;
-    if (r->vehicle == SIM_VEHICLE_CLAPPER) {
-        snprintf(err, errlen, "the clapper's two-truck path following comes with the IPEC issue; "
-                              "use --vehicle labmate or set");
-        return -1;
-    }
+    const bool clapper = r->vehicle == SIM_VEHICLE_CLAPPER;
     if (sim_world_init(&st->world, r, cfg->scenario, cfg->seed, err, errlen) != 0) {
         return -1;
     }
@@ -63,13 +80,22 @@ static int setup(sil_state_t *st, const sim_run_config_t *cfg, char *err, size_t
                           &st->prog, err, errlen) != 0) {
         return -1;
     }
+    if (clapper && sim_program_for_clapper(&st->prog, r->link.length_mm) != 0) {
+        snprintf(err, errlen, "the clapper's link length must be positive");
+        return -1;
+    }
+    /* A floor bump lies under that side's wheels of every driven truck that passes it (004 s. 6.1:
+     * under the right-side wheels of both trucks; "some affected only one of the two trucks");
+     * the set's trailer keeps off the program's bumps. */
     for (size_t i = 0; i < st->prog.n_bumps; ++i) {
         const sim_bump_t *b = &st->prog.bump[i];
-        if (sim_world_add_bump(&st->world, ODO_TRUCK_A, b->side, b->at_path_mm, b->height_mm) != 0) {
+        double at_b = 0.0;
+        if (sim_world_add_bump(&st->world, ODO_TRUCK_A, b->side, b->at_path_mm, b->height_mm) != 0 ||
+            (clapper && travel_of_b(&st->prog, b->at_path_mm, r->link.length_mm, &at_b) &&
+             sim_world_add_bump(&st->world, ODO_TRUCK_B, b->side, at_b, b->height_mm) != 0)) {
             snprintf(err, errlen, "bump %zu of the program does not fit the world", i);
             return -1;
         }
-        (void)travel_of_b;
     }
 
     odo_params_t p;
@@ -100,6 +126,10 @@ static int setup(sil_state_t *st, const sim_run_config_t *cfg, char *err, size_t
         return -1;
     }
     sim_follower_init(&st->follow, &st->prog, r->truck[0].wheelbase_mm, r->tick_ms / 1000.0);
+    if (clapper) {
+        sim_clapper_follower_init(&st->follow2, &st->prog, r->truck[0].wheelbase_mm, r->truck[1].wheelbase_mm,
+                                  r->link.length_mm, r->tick_ms / 1000.0);
+    }
     return 0;
 }
 
@@ -165,12 +195,30 @@ int sim_run(const sim_run_config_t *cfg, sim_tick_fn on_tick, void *user, sim_re
         if (!running && ++settle > 2) {
             break; /* stopped for a couple of ticks after the last segment */
         }
-        const odo_pose_t *pa = &st->out.pose[ODO_TRUCK_A];
-        double wheel[2];
-        running = sim_follower_step(&st->follow, q32_mm(pa->x_mm_q32), q32_mm(pa->y_mm_q32),
-                                    q64_rad(pa->heading_q64), wheel) && running;
-        cmd[0][0] = wheel[0];
-        cmd[0][1] = wheel[1];
+        if (r->vehicle == SIM_VEHICLE_CLAPPER) {
+            /* The navigation computer drives both trucks from the firmware's poses and the
+             * linkage encoders as the firmware read them (IPEC, when on, lives in the poses). */
+            double pose[2][3];
+            for (unsigned t = 0; t < 2U; ++t) {
+                const odo_pose_t *pt = &st->out.pose[t];
+                pose[t][0] = q32_mm(pt->x_mm_q32);
+                pose[t][1] = q32_mm(pt->y_mm_q32);
+                pose[t][2] = q64_rad(pt->heading_q64);
+            }
+            const sim_link_meas_t link = {
+                .length_mm = st->in.link.length_um / 1000.0,
+                .alpha_rad = (int16_t)st->in.link.alpha_bam16 * (M_PI / 32768.0),
+                .beta_rad = (int16_t)st->in.link.beta_bam16 * (M_PI / 32768.0),
+            };
+            running = sim_clapper_follower_step(&st->follow2, (const double(*)[3])pose, &link, cmd) && running;
+        } else {
+            const odo_pose_t *pa = &st->out.pose[ODO_TRUCK_A];
+            double wheel[2];
+            running = sim_follower_step(&st->follow, q32_mm(pa->x_mm_q32), q32_mm(pa->y_mm_q32),
+                                        q64_rad(pa->heading_q64), wheel) && running;
+            cmd[0][0] = wheel[0];
+            cmd[0][1] = wheel[1];
+        }
         for (unsigned k = 0; k < steps && rc == 0; ++k) {
             if (sim_world_step(&st->world, dt, (const double(*)[2])cmd) != 0) {
                 snprintf(err, errlen, "the world refused a step at t = %.3f s", sim_world_time_s(&st->world));

@@ -139,3 +139,59 @@ int sim_program_build(const char *experiment, int ccw, int bumps, double bump_he
     }
     return 0;
 }
+
+int sim_program_for_clapper(sim_program_t *p, double link_length_mm)
+{
+    if (!(link_length_mm > 0.0)) {
+        return -1;
+    }
+    const double half = link_length_mm / 2.0;
+    double x = 0.0, y = 0.0, heading = 0.0; /* nominal pose of truck A */
+    double ox = 0.0, oy = 0.0;              /* offset the rigid turns so far put on A's path */
+    for (size_t i = 0; i < p->n_seg; ++i) {
+        sim_segment_t *s = &p->seg[i];
+        switch (s->kind) {
+        case SIM_SEG_LINE: {
+            s->x0_mm += ox;
+            s->y0_mm += oy;
+            s->x1_mm += ox;
+            s->y1_mm += oy;
+            x = s->x1_mm;
+            y = s->y1_mm;
+            const double dx = s->x1_mm - s->x0_mm, dy = s->y1_mm - s->y0_mm;
+            heading = atan2(dy, dx) + (s->speed_mm_s < 0.0 ? M_PI : 0.0);
+            break;
+        }
+        case SIM_SEG_ARC: {
+            s->x0_mm += ox;
+            s->y0_mm += oy;
+            s->cx_mm += ox;
+            s->cy_mm += oy;
+            const double a1 = atan2(s->y0_mm - s->cy_mm, s->x0_mm - s->cx_mm) + s->sweep_rad;
+            x = s->cx_mm + s->radius_mm * cos(a1);
+            y = s->cy_mm + s->radius_mm * sin(a1);
+            heading += s->sweep_rad;
+            break;
+        }
+        case SIM_SEG_TURN: {
+            const double sweep = remainder(s->heading_rad - heading, 2.0 * M_PI);
+            s->x0_mm = x;
+            s->y0_mm = y;
+            s->cx_mm = x - half * cos(heading);
+            s->cy_mm = y - half * sin(heading);
+            s->radius_mm = half;
+            s->sweep_rad = sweep;
+            heading = s->heading_rad;
+            s->x1_mm = s->cx_mm + half * cos(heading);
+            s->y1_mm = s->cy_mm + half * sin(heading);
+            ox += s->x1_mm - x;
+            oy += s->y1_mm - y;
+            x = s->x1_mm;
+            y = s->y1_mm;
+            break;
+        }
+        case SIM_SEG_PAUSE: break;
+        }
+    }
+    return 0;
+}

@@ -28,6 +28,9 @@ typedef struct {
     double radius_mm;         ///< ARC radius
     double sweep_rad;         ///< ARC signed sweep (ccw positive)
     double heading_rad;       ///< TURN: target heading (absolute, nominal frame)
+                              ///< clapper TURN (sim_program_for_clapper): x0/y0 truck A before,
+                              ///< x1/y1 after, cx/cy the pivot (the vehicle's midpoint), radius_mm
+                              ///< l/2, sweep_rad the signed turn angle
     double speed_mm_s;        ///< LINE/ARC cruise speed (negative: drive backward); TURN wheel speed
     double accel_mm_s2;       ///< ramp rate
     double pause_s;           ///< PAUSE duration
@@ -59,5 +62,14 @@ extern const char *const sim_experiment_names[];
 /// unknown experiment or more bumps than fit.
 int sim_program_build(const char *experiment, int ccw, int bumps, double bump_height_mm,
                       unsigned run_index, sim_program_t *out, char *err, size_t errlen);
+
+/// Adapt a built program to the clapper (two trucks l apart, A in front): every TURN becomes a
+/// rigid turn of the whole vehicle about its midpoint, l/2 behind truck A (see follower.h), so A
+/// does not end the turn where it started it; the LINE/ARC segments that follow are moved by the
+/// same offset (direction, length and speed kept) so that A starts each of them where the turn
+/// left it. For umbmark this makes the midpoint, not truck A, drive the 4 x 4 m square, and A is
+/// back at the origin heading +x after the fourth turn. Paths without TURNs (straight-36m,
+/// rect-7x4) are unchanged. Bumps keep their path distances. Returns 0, or -1 for l <= 0.
+int sim_program_for_clapper(sim_program_t *p, double link_length_mm);
 
 #endif
