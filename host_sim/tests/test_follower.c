@@ -2,8 +2,10 @@
 /// offset back onto the line driving forward AND backward (straight-36m's return leg, 004 s. 6.1),
 /// and land on-the-spot turns within its tolerance.
 #include <check.h>
+
 #include <math.h>
 
+#include "check_support.h"
 #include "follower.h"
 #include "program.h"
 
@@ -71,9 +73,5 @@ int main(void)
     tcase_add_test(tc, line_following_converges_forward_and_backward);
     tcase_add_test(tc, on_the_spot_turns_land_within_tolerance);
     suite_add_tcase(s, tc);
-    SRunner *sr = srunner_create(s);
-    srunner_run_all(sr, CK_NORMAL);
-    const int failed = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return failed == 0 ? 0 : 1;
+    return ts_run_suite(s);
 }

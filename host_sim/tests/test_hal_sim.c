@@ -3,9 +3,11 @@
 /// like 10-bit absolute encoders and a 0.1 mm linear scale (004 section 2), sent frames are
 /// captured, and identical runs read identically (issue 3 item 7).
 #include <check.h>
+
 #include <math.h>
 #include <string.h>
 
+#include "check_support.h"
 #include "hal_sim.h"
 #include "odo_loop.h"
 #include "test_support.h"
@@ -282,9 +284,5 @@ int main(void)
     tcase_add_test(tc, sent_frames_are_captured_and_overflow_is_counted);
     tcase_add_test(tc, firmware_runs_on_emulated_counters_and_identical_runs_read_identically);
     suite_add_tcase(s, tc);
-    SRunner *sr = srunner_create(s);
-    srunner_run_all(sr, CK_NORMAL);
-    const int failed = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return failed == 0 ? 0 : 1;
+    return ts_run_suite(s);
 }

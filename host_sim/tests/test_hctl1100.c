@@ -3,9 +3,11 @@
 /// its direction convention, 24-bit wrap, the filter's count limit, the byte-wise read protocol
 /// and its tearing, and the fast path agreeing with the per-edge path.
 #include <check.h>
+
 #include <math.h>
 #include <stdlib.h>
 
+#include "check_support.h"
 #include "hctl1100.h"
 #include "test_support.h"
 
@@ -337,9 +339,5 @@ int main(void)
     tcase_add_test(tc, index_pulses_leave_the_position_alone);
     tcase_add_test(tc, bad_inputs_are_refused_and_counted);
     suite_add_tcase(s, tc);
-    SRunner *sr = srunner_create(s);
-    srunner_run_all(sr, CK_NORMAL);
-    const int failed = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return failed == 0 ? 0 : 1;
+    return ts_run_suite(s);
 }

@@ -1,11 +1,13 @@
 /// The simulator's world, bump geometry, effects catalog and robot description (issue 3, items 1,
 /// 2 and 8). Each test is named after what it shows and cites the paper it reproduces.
 #include <check.h>
+
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "check_support.h"
 #include "bump.h"
 #include "effects.h"
 #include "odo/odo_params.h"
@@ -649,9 +651,5 @@ static Suite *suite(void)
 
 int main(void)
 {
-    SRunner *sr = srunner_create(suite());
-    srunner_run_all(sr, CK_NORMAL);
-    const int failed = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return failed == 0 ? EXIT_SUCCESS : EXIT_FAILURE;
+    return ts_run_suite(suite());
 }

@@ -1,8 +1,10 @@
 /// The HAL-driven tick (firmware/app/odo_loop.c) on the scripted test backend: reads counters
 /// through the HAL, publishes through the HAL, and never loses a tick when sends are refused.
 #include <check.h>
+
 #include <string.h>
 
+#include "check_support.h"
 #include "hal_test.h"
 #include "odo/odo_can.h"
 #include "odo_loop.h"
@@ -72,9 +74,5 @@ int main(void)
     tcase_add_test(tc, absent_sample_is_reported_as_missing);
     tcase_add_test(tc, refused_sends_are_counted_and_the_tick_is_not_lost);
     suite_add_tcase(s, tc);
-    SRunner *sr = srunner_create(s);
-    srunner_run_all(sr, CK_NORMAL);
-    const int failed = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return failed == 0 ? 0 : 1;
+    return ts_run_suite(s);
 }

@@ -4,9 +4,11 @@
 /// crossing their wrap, both heading forms, and random UMBmark calibrations.
 /// Requirement (DESIGN.md s. 3): <= 0.1 mm and <= 1e-6 rad after 1 km.
 #include <check.h>
+
 #include <math.h>
 #include <stdio.h>
 
+#include "check_support.h"
 #include "odo/odo_params.h"
 #include "odo_refcheck.h"
 #include "test_support.h"
@@ -80,9 +82,5 @@ int main(void)
     tcase_add_test(tc, fixed_point_pose_matches_double_reference_after_1km);
     tcase_add_test(tc, comparison_detects_a_1e6_calibration_mismatch);
     suite_add_tcase(s, tc);
-    SRunner *sr = srunner_create(s);
-    srunner_run_all(sr, CK_NORMAL);
-    const int failed = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return failed == 0 ? 0 : 1;
+    return ts_run_suite(s);
 }
