@@ -127,6 +127,35 @@ static void publish(const odo_app_t *app, const uint8_t pose_flags[ODO_TRUCKS], 
     out->n_frames = n;
 }
 
+/// Linkage check and, with IPEC on, the correction of both trucks (odo_ipec.h). Returns faults.
+static uint32_t ipec_tick(odo_app_t *app, const odo_tick_input_t *in, bool dr_ok,
+                          uint8_t pose_flags[ODO_TRUCKS], odo_tick_output_t *out)
+{
+    odo_ipec_reading_t rd;
+    uint32_t f = odo_ipec_check(&app->ipec, &app->params, &in->link, &rd);
+    if (app->params.ipec_mode == (uint8_t)ODO_IPEC_OFF) {
+        return f;
+    }
+    if (f != 0U || !dr_ok) {
+        pose_flags[ODO_TRUCK_A] |= ODO_POSE_FLAG_IPEC_GATED;
+        pose_flags[ODO_TRUCK_B] |= ODO_POSE_FLAG_IPEC_GATED;
+        return f | ODO_FAULT_IPEC_GATED;
+    }
+    odo_pose_t pose[ODO_TRUCKS] = {app->truck[ODO_TRUCK_A].pose, app->truck[ODO_TRUCK_B].pose};
+    odo_ipec_result_t r;
+    odo_ipec_step(&app->params, &rd, pose, out->dist_mm_q40[ODO_TRUCK_A], &r);
+    for (uint8_t i = 0U; i < ODO_TRUCKS; ++i) {
+        app->truck[i].pose = pose[i];
+        out->ipec_dtheta_bam[i] = r.dtheta_bam[i];
+        out->ipec_innov_bam[i] = r.innov_bam[i];
+        if (r.dtheta_bam[i] != 0) {
+            pose_flags[i] |= ODO_POSE_FLAG_IPEC;
+        }
+    }
+    out->ipec_applied = true;
+    return f;
+}
+
 void odo_app_step(odo_app_t *app, const odo_tick_input_t *in, odo_tick_output_t *out)
 {
     uint32_t faults = in->rx_faults;
@@ -142,9 +171,11 @@ void odo_app_step(odo_app_t *app, const odo_tick_input_t *in, odo_tick_output_t 
     app->have_time = true;
     app->last_t_us = in->t_us;
 
+    bool dr_ok = true; /* every truck's sample integrated: IPEC may compare */
     for (uint8_t i = 0U; i < app->trucks; ++i) {
         const odo_wheel_input_t *w = &in->wheel[i];
         if (!w->present) {
+            dr_ok = false;
             faults |= FAULT_MISSING[i];
             pose_flags[i] |= ODO_POSE_FLAG_MISSING;
             continue;
@@ -157,9 +188,16 @@ void odo_app_step(odo_app_t *app, const odo_tick_input_t *in, odo_tick_output_t 
         odo_step_t st;
         odo_truck_step(&app->truck[i], &app->model[i], w->left_raw, w->right_raw, w->bits, &st);
         if (st.jump) {
+            dr_ok = false;
             faults |= FAULT_JUMP[i];
             pose_flags[i] |= ODO_POSE_FLAG_JUMP;
         }
+        out->dist_mm_q40[i] = st.dist_mm_q40;
+        out->dturn_q64[i] = st.dturn_q64;
+    }
+
+    if (app->trucks == 2U) {
+        faults |= ipec_tick(app, in, dr_ok, pose_flags, out);
     }
 
     for (uint8_t i = 0U; i < ODO_TRUCKS; ++i) {

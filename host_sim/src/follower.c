@@ -162,6 +162,8 @@ bool sim_follower_step(sim_follower_t *f, double x_mm, double y_mm, double theta
 #define LINK_MAX_CORR_MM_S 400.0  /* cap on that correction */
 #define SYNC_K_PER_S 2.0          /* rigid turn: keeps both trucks' progress equal */
 #define REL_K_PER_S 3.0           /* rigid turn: holds each truck perpendicular to the link */
+#define SPIN_SETTLE_RAD (0.8 * M_PI / 180.0) /* a spin within this of its target ... */
+#define SPIN_SETTLE_TICKS 25U                /* ... for this many ticks is done */
 #define TILT_MAX_RAD 0.35         /* rigid turn: B's largest tilt for the l loop */
 
 /// Cross-track steering valid in both driving directions: for a truck moving at signed speed v
@@ -214,7 +216,11 @@ static bool spin(sim_clapper_follower_t *f, unsigned t, const sim_segment_t *s, 
 {
     const double err = wrap_pi(target - th);
     out[0] = out[1] = 0.0;
-    if (fabs(err) <= TURN_DONE_RAD) {
+    /* With IPEC's per-tick form the published heading is theta_L plus the rotary code's centre,
+     * so it cannot settle finer than a rotary step: a spin that has been within SPIN_SETTLE_RAD
+     * for SPIN_SETTLE_TICKS ticks is done too (otherwise the truck would chase the code forever). */
+    f->spin_settled[t] = fabs(err) <= SPIN_SETTLE_RAD ? f->spin_settled[t] + 1U : 0U;
+    if (fabs(err) <= TURN_DONE_RAD || f->spin_settled[t] > SPIN_SETTLE_TICKS) {
         f->w_turn_rad_s[t] = 0.0;
         return false;
     }
@@ -272,6 +278,7 @@ static bool rigid_turn(sim_clapper_follower_t *f, const sim_segment_t *s, const 
     while (f->turn_phase < 3) {
         if (!f->phase_started) {
             f->phase_started = true;
+            f->spin_settled[0] = f->spin_settled[1] = 0U;
             for (unsigned t = 0; t < 2U; ++t) {
                 const double rel = t == 0U ? link->alpha_rad : link->beta_rad;
                 /* Phase 0 aims each truck perpendicular to the link as measured (its centre does

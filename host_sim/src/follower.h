@@ -67,6 +67,7 @@ typedef struct {
     double   w_turn_rad_s[2];  ///< last on-the-spot rates (A, B), phases 0 and 2
     double   w_arc_rad_s;      ///< last common angular speed about the midpoint, phase 1
     double   v_b_mm_s;         ///< last commanded speed of B
+    unsigned spin_settled[2];  ///< ticks each truck's spin has been within SPIN_SETTLE_RAD
 } sim_clapper_follower_t;
 
 void sim_clapper_follower_init(sim_clapper_follower_t *f, const sim_program_t *prog, double wheelbase_a_mm,

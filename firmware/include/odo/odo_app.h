@@ -2,14 +2,21 @@
 /// host_sim, odo-replay (offline and live), the vcan test and the Cortex-M image all call
 /// odo_app_step; only firmware/app/odo_loop.c touches the HAL around it.
 ///
-/// Per tick: sequence/fault bookkeeping -> per-truck odometry (odo_odometry.h) -> [IPEC] -> output
-/// frames (pose per truck, IPEC corrections, status) packed with the DBC codec (odo_can.h).
+/// Per tick: sequence/fault bookkeeping -> per-truck odometry (odo_odometry.h) -> linkage checks
+/// and, with ipec_mode on, the IPEC correction (odo_ipec.h) within the same tick -> output frames
+/// (pose per truck, IPEC corrections, status) packed with the DBC codec (odo_can.h).
+///
+/// IPEC gating: the correction runs only when both trucks' wheel samples were integrated and the
+/// linkage sample passed odo_ipec_check; otherwise that tick is dead reckoning only, the check's
+/// fault bit and ODO_FAULT_IPEC_GATED are raised in STATUS, and both POSE_THETA frames carry
+/// ODO_POSE_FLAG_IPEC_GATED. The linkage is checked (and its faults reported) with IPEC off too.
 #ifndef ODO_APP_H
 #define ODO_APP_H
 
 #include <stddef.h>
 #include <stdint.h>
 
+#include "odo/odo_ipec.h"
 #include "odo/odo_odometry.h"
 #include "odo/odo_params.h"
 #include "odo/odo_status.h"
@@ -26,6 +33,7 @@ extern "C" {
 #define ODO_POSE_FLAG_MISSING 0x01U ///< no wheel sample: pose held
 #define ODO_POSE_FLAG_JUMP    0x02U ///< implausible counter jump: pose held, baseline re-taken
 #define ODO_POSE_FLAG_IPEC    0x04U ///< an IPEC heading correction was applied
+#define ODO_POSE_FLAG_IPEC_GATED 0x08U ///< IPEC is on but was skipped this tick (see faults)
 
 /// Application state. Plain data, caller-allocated (static on the target); no pointers inside,
 /// so it can be copied to checkpoint a run.
@@ -34,6 +42,7 @@ typedef struct {
     odo_params_status_t  params_status;  ///< result of the boot-time load (OK or why defaulted)
     odo_model_t          model[ODO_TRUCKS];
     odo_truck_t          truck[ODO_TRUCKS];
+    odo_ipec_t           ipec;           ///< linkage bookkeeping (two-truck vehicles)
     uint8_t              trucks;         ///< 1 (single) or 2 (clapper, set)
     uint8_t              out_seq;        ///< sequence number of the output frames
     bool                 seen_seq[ODO_TRUCKS];
@@ -49,6 +58,11 @@ typedef struct {
 typedef struct {
     odo_pose_t      pose[ODO_TRUCKS];
     int32_t         ipec_dtheta_bam[ODO_TRUCKS]; ///< correction applied this tick (0 when off/gated)
+    int32_t         ipec_innov_bam[ODO_TRUCKS];  ///< measured minus expected link angle (002 Eq. 12)
+                                                 ///< before the estimator; 0 when off/gated
+    bool            ipec_applied;                ///< the IPEC computation ran this tick
+    int64_t         dist_mm_q40[ODO_TRUCKS];     ///< dead-reckoning displacement U_i (0: none)
+    int64_t         dturn_q64[ODO_TRUCKS];       ///< dead-reckoning heading change, signed turns Q64
     uint32_t        faults;                      ///< ODO_FAULT_* bits raised this tick
     uint8_t         n_frames;
     odo_can_frame_t frames[ODO_APP_MAX_FRAMES];  ///< to publish, in order
