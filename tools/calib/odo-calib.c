@@ -1,0 +1,580 @@
+/// odo-calib: UMBmark calibration (000_12e7709aa9cd375a.txt s. 6) and the parameter block in
+/// firmware images. See tools/calib/README.md and `odo-calib --help`.
+///
+/// Exit status: 0 ok; 1 rejected input, a failed calibration or an I/O error (message on stderr
+/// naming the file and, where there is one, the line); 2 usage error. Outputs are written to a
+/// temporary file in the destination's folder and renamed into place, so on any error the
+/// destination keeps its old content.
+#include <errno.h>
+#include <fcntl.h>
+#include <inttypes.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "acceptance.h"
+#include "calib_core.h"
+#include "image.h"
+#include "params_json.h"
+#include "returns_csv.h"
+#include "robot.h"
+
+#define EXIT_FAIL  1
+#define EXIT_USAGE 2
+#define Q30        1073741824.0
+#define BAM_DEG    (180.0 / 2147483648.0)
+
+static const char *const k_prog = "odo-calib";
+
+static void usage(FILE *f)
+{
+    fprintf(f,
+            "usage: odo-calib <command> [options]      (odo-calib <command> --help for details)\n"
+            "\n"
+            "  umbmark --returns returns.csv --side-mm 4000 (--robot R.json | --params P.json|P.bin)\n"
+            "          [--robot R.json --params P] [--method paper|exact] [--json] [--out-params P.json|P.bin]\n"
+            "      UMBmark calibration (000 s. 6) of truck A from the return errors (000 Eq. 3.1);\n"
+            "      --params: the block the robot ran the test with (default: from --robot).\n"
+            "  write --image FW --params P.json|P.bin [--out OUT] [--force]\n"
+            "      put the parameter block into a firmware image (raw .bin, Intel HEX or ELF\n"
+            "      .odo_params); CRC recomputed; in place unless --out.\n"
+            "  read --image FW [--json]     print the image's parameter block\n"
+            "  verify --image FW            check the image's block (layout, version, CRC, ranges)\n"
+            "  export --params P.json|P.bin --format ros2\n"
+            "      diff_drive_controller multipliers (YAML) for ros2_controllers\n"
+            "  acceptance [--robots N] [--seed S] [--runs N] [--json] [--no-tape] [--quiet]\n"
+            "      simulated labmates (Ed ~ U[0.995, 1.005], b ~ U[0.97, 1.03] x 340 mm, floor\n"
+            "      roughness): Emax,syst before/after one pass, exact and paper methods; E-7/E-8\n"
+            "      tape analogues; noise-free recovery. Prints a 000 Table III-like table.\n"
+            "\n"
+            "Exit status: 0 ok, 1 rejected input or I/O error, 2 usage error.\n");
+}
+
+static int is_help(const char *a) { return strcmp(a, "-h") == 0 || strcmp(a, "--help") == 0; }
+
+/// Options as name/value pairs; flags have value "1".
+typedef struct {
+    const char *name;
+    int         takes_value;
+    const char *value;
+} opt_t;
+
+static int parse_opts(const char *cmd, int argc, char **argv, opt_t *o, size_t n)
+{
+    for (int i = 0; i < argc; ++i) {
+        size_t k = 0;
+        while (k < n && strcmp(argv[i], o[k].name) != 0) {
+            k++;
+        }
+        if (k == n) {
+            fprintf(stderr, "%s %s: unknown argument '%s' (see %s %s --help)\n", k_prog, cmd, argv[i], k_prog, cmd);
+            return -1;
+        }
+        if (o[k].takes_value) {
+            if (i + 1 >= argc) {
+                fprintf(stderr, "%s %s: %s needs a value\n", k_prog, cmd, argv[i]);
+                return -1;
+            }
+            o[k].value = argv[++i];
+        } else {
+            o[k].value = "1";
+        }
+    }
+    return 0;
+}
+
+static const char *opt(const opt_t *o, size_t n, const char *name)
+{
+    for (size_t k = 0; k < n; ++k) {
+        if (strcmp(o[k].name, name) == 0) {
+            return o[k].value;
+        }
+    }
+    return NULL;
+}
+
+static int ends_with(const char *s, const char *suf)
+{
+    const size_t a = strlen(s), b = strlen(suf);
+    return a >= b && strcmp(s + a - b, suf) == 0;
+}
+
+/// Write a text or binary output atomically: path.tmp.<pid>, fsync, rename.
+static int write_atomic(const char *path, const void *data, size_t len)
+{
+    char tmp[4096];
+    if (snprintf(tmp, sizeof tmp, "%s.tmp.%ld", path, (long)getpid()) >= (int)sizeof tmp) {
+        fprintf(stderr, "%s: output path too long\n", k_prog);
+        return -1;
+    }
+    const int fd = open(tmp, O_WRONLY | O_CREAT | O_EXCL, 0644);
+    if (fd < 0) {
+        fprintf(stderr, "%s: cannot create %s: %s\n", k_prog, tmp, strerror(errno));
+        return -1;
+    }
+    const uint8_t *p = data;
+    size_t left = len;
+    while (left > 0) {
+        const ssize_t w = write(fd, p, left);
+        if (w < 0 && errno == EINTR) {
+            continue;
+        }
+        if (w <= 0) {
+            fprintf(stderr, "%s: cannot write %s: %s\n", k_prog, tmp, strerror(errno));
+            close(fd);
+            unlink(tmp);
+            return -1;
+        }
+        p += w;
+        left -= (size_t)w;
+    }
+    if (fsync(fd) != 0 || close(fd) != 0 || rename(tmp, path) != 0) {
+        fprintf(stderr, "%s: cannot write %s: %s\n", k_prog, path, strerror(errno));
+        unlink(tmp);
+        return -1;
+    }
+    return 0;
+}
+
+/// Parameters as JSON text (malloc'd) or as the 128-byte block, by the output's extension.
+static int write_params(const char *path, const odo_params_t *p)
+{
+    if (ends_with(path, ".bin")) {
+        uint8_t block[ODO_PARAMS_SIZE];
+        (void)odo_params_encode(p, block, sizeof block);
+        return write_atomic(path, block, sizeof block);
+    }
+    char *buf = NULL;
+    size_t len = 0;
+    FILE *m = open_memstream(&buf, &len);
+    if (m == NULL || odo_params_json_write(m, p) != 0 || fclose(m) != 0) {
+        free(buf);
+        fprintf(stderr, "%s: out of memory\n", k_prog);
+        return -1;
+    }
+    const int rc = write_atomic(path, buf, len);
+    free(buf);
+    return rc;
+}
+
+/* ---------------------------------------------------------------------------------------------
+ * umbmark
+ * ------------------------------------------------------------------------------------------- */
+
+static void print_calib_json(FILE *f, const calib_result_t *c, const char *returns_path, double side_mm,
+                             const char *out_params)
+{
+    const odo_umb_stats_t *s = &c->st;
+    const odo_umb_calib_t *p = &c->paper;
+    fprintf(f, "{\"method\": \"%s\", \"returns\": \"%s\", \"side_mm\": %.3f,\n", c->method == CALIB_EXACT ? "exact" : "paper",
+            returns_path, side_mm);
+    fprintf(f, " \"Ed\": %.9f, \"Eb\": %.9f, \"cL\": %.9f, \"cR\": %.9f, \"b_actual_mm\": %.4f,\n", c->ed_q30 / Q30,
+            c->eb_q30 / Q30, c->cl_q30 / Q30, c->cr_q30 / Q30, c->b_actual_mm);
+    fprintf(f, " \"ed_q30\": %" PRId32 ", \"eb_q30\": %" PRId32 ", \"ed_in_force\": %.9f, \"eb_in_force\": %.9f,\n",
+            c->ed_q30, c->eb_q30, c->ed_in_force, c->eb_in_force);
+    fprintf(f, " \"alpha_deg\": %.6f, \"beta_deg\": %.6f, \"alpha_x_deg\": %.6f, \"alpha_y_deg\": %.6f, "
+               "\"beta_x_deg\": %.6f, \"beta_y_deg\": %.6f,\n \"alpha_disagree_deg\": %.6f, \"beta_disagree_deg\": %.6f, "
+               "\"radius_mm\": %.1f,\n",
+            p->alpha_bam * BAM_DEG, p->beta_bam * BAM_DEG, p->alpha_x_bam * BAM_DEG, p->alpha_y_bam * BAM_DEG,
+            p->beta_x_bam * BAM_DEG, p->beta_y_bam * BAM_DEG, p->alpha_disagree_bam * BAM_DEG,
+            p->beta_disagree_bam * BAM_DEG, p->radius_um / 1000.0);
+    fprintf(f, " \"runs_cw\": %u, \"runs_ccw\": %u, \"cg_cw_mm\": [%.3f, %.3f], \"cg_ccw_mm\": [%.3f, %.3f], "
+               "\"r_cg_cw_mm\": %.3f, \"r_cg_ccw_mm\": %.3f,\n",
+            s->n[0], s->n[1], s->cg_x_um[0] / 1000.0, s->cg_y_um[0] / 1000.0, s->cg_x_um[1] / 1000.0,
+            s->cg_y_um[1] / 1000.0, s->r_cg_um[0] / 1000.0, s->r_cg_um[1] / 1000.0);
+    fprintf(f, " \"emax_syst_mm\": %.3f, \"sigma_mm\": %.3f, \"sem_mm\": %.3f, \"second_pass_advised\": %s,\n",
+            s->emax_syst_um / 1000.0, s->sigma_um / 1000.0, s->sem_um / 1000.0, s->second_pass_advised ? "true" : "false");
+    fprintf(f, " \"theta_bias_cw_deg\": %.6f, \"theta_bias_ccw_deg\": %.6f, \"avg_abs_theta_deg\": %.6f,\n",
+            s->theta_bias_udeg[0] / 1e6, s->theta_bias_udeg[1] / 1e6, s->avg_abs_theta_udeg / 1e6);
+    fprintf(f, " \"paper\": {\"Ed\": %.9f, \"Eb\": %.9f, \"b_actual_mm\": %.4f, \"ed_measured\": %.9f, \"eb_measured\": %.9f},\n",
+            p->ed_q30 / Q30, p->eb_q30 / Q30, p->b_actual_nm / 1e6, p->ed_meas_q30 / Q30, p->eb_meas_q30 / Q30);
+    if (c->method == CALIB_EXACT) {
+        fprintf(f, " \"exact\": {\"Ed\": %.9f, \"b_mm\": %.5f, \"residual_mm\": %.4f, \"iterations\": %d, "
+                   "\"converged\": %s, \"identifiable\": %s, \"singular_value_ratio\": %.3e},\n",
+                c->fit.ed, c->fit.b_mm, c->fit.residual_mm, c->fit.iterations, c->fit.converged ? "true" : "false",
+                c->fit.identifiable ? "true" : "false", c->fit.sv_max > 0 ? c->fit.sv_min / c->fit.sv_max : 0.0);
+    }
+    fprintf(f, " \"not_identifiable\": [\"es: a closed square does not show the scale error; measure it with a tape "
+               "(000 App. B)\", \"truck B: UMBmark returns are truck A's\"%s],\n",
+            c->method == CALIB_EXACT && !c->fit.identifiable ? ", \"Ed and b: the data do not separate them\"" : "");
+    fprintf(f, " \"out_params\": ");
+    if (out_params != NULL) {
+        fprintf(f, "\"%s\"}\n", out_params);
+    } else {
+        fprintf(f, "null}\n");
+    }
+}
+
+static void print_calib_table(FILE *f, const calib_result_t *c)
+{
+    const odo_umb_stats_t *s = &c->st;
+    const odo_umb_calib_t *p = &c->paper;
+    fprintf(f, "UMBmark (000 s. 3): %u cw + %u ccw runs\n", s->n[0], s->n[1]);
+    fprintf(f, "  cg cw  (%9.2f, %9.2f) mm   r %8.2f mm   (Eqs. 3.2, 3.3)\n", s->cg_x_um[0] / 1e3, s->cg_y_um[0] / 1e3,
+            s->r_cg_um[0] / 1e3);
+    fprintf(f, "  cg ccw (%9.2f, %9.2f) mm   r %8.2f mm\n", s->cg_x_um[1] / 1e3, s->cg_y_um[1] / 1e3, s->r_cg_um[1] / 1e3);
+    fprintf(f, "  Emax,syst %.2f mm (Eq. 3.4)   sigma %.2f mm   SEM %.2f mm   second pass %s (Emax,syst %s 3 SEM)\n",
+            s->emax_syst_um / 1e3, s->sigma_um / 1e3, s->sem_um / 1e3, s->second_pass_advised ? "advised" : "not needed",
+            s->second_pass_advised ? ">" : "<=");
+    fprintf(f, "  alpha %.4f deg (x %.4f, y %.4f)   beta %.4f deg (x %.4f, y %.4f)   (Eqs. 6.22, 6.26)\n",
+            p->alpha_bam * BAM_DEG, p->alpha_x_bam * BAM_DEG, p->alpha_y_bam * BAM_DEG, p->beta_bam * BAM_DEG,
+            p->beta_x_bam * BAM_DEG, p->beta_y_bam * BAM_DEG);
+    fprintf(f, "\n%-8s %12s %12s %12s %12s %14s\n", "method", "Ed", "Eb", "cL", "cR", "b_actual mm");
+    fprintf(f, "%-8s %12.7f %12.7f %12.7f %12.7f %14.3f\n", "paper", p->ed_q30 / Q30, p->eb_q30 / Q30, p->cl_q30 / Q30,
+            p->cr_q30 / Q30, p->b_actual_nm / 1e6);
+    if (c->method == CALIB_EXACT) {
+        fprintf(f, "%-8s %12.7f %12.7f %12.7f %12.7f %14.3f   (fit residual %.3f mm, %d iterations%s)\n", "exact",
+                c->ed_q30 / Q30, c->eb_q30 / Q30, c->cl_q30 / Q30, c->cr_q30 / Q30, c->b_actual_mm, c->fit.residual_mm,
+                c->fit.iterations, c->fit.identifiable ? "" : ", NOT identifiable");
+    }
+    fprintf(f, "\nnot identifiable from UMBmark: Es (measure with a tape, 000 App. B); truck B.\n");
+}
+
+/// The parameter block in force from --robot and/or --params.
+static int params_in_force(const char *cmd, const char *robot_path, const char *params_path, odo_params_t *p)
+{
+    char err[512];
+    if (params_path != NULL) {
+        if (odo_params_file_load(params_path, p, err, sizeof err) != 0) {
+            fprintf(stderr, "%s %s: %s\n", k_prog, cmd, err);
+            return -1;
+        }
+        return 0;
+    }
+    static sim_robot_t robot;
+    if (sim_robot_parse_file(robot_path, &robot, err, sizeof err) != 0 ||
+        sim_robot_to_params(&robot, p, err, sizeof err) != 0) {
+        fprintf(stderr, "%s %s: %s\n", k_prog, cmd, err);
+        return -1;
+    }
+    return 0;
+}
+
+static int cmd_umbmark(int argc, char **argv)
+{
+    opt_t o[] = {{"--returns", 1, NULL}, {"--side-mm", 1, NULL}, {"--robot", 1, NULL}, {"--params", 1, NULL},
+                 {"--method", 1, NULL}, {"--json", 0, NULL}, {"--out-params", 1, NULL}};
+    const size_t n = sizeof o / sizeof o[0];
+    for (int i = 0; i < argc; ++i) {
+        if (is_help(argv[i])) {
+            printf("usage: odo-calib umbmark --returns returns.csv --side-mm L (--robot R.json | --params P)\n"
+                   "                        [--method paper|exact] [--json] [--out-params P.json|P.bin]\n"
+                   "\n"
+                   "Reads the return errors (host_sim/README.md returns.csv contract, 000 Eq. 3.1), computes\n"
+                   "the centres of gravity, Emax,syst, sigma and SEM (Eqs. 3.2-3.4, s. 6.3), alpha and beta\n"
+                   "(x and y forms, Eqs. 6.19-6.26) and the corrections Ed, Eb, cL, cR, b_actual (Eqs.\n"
+                   "6.23-6.34). --method exact (default) fits Ed and b to the centres of gravity without\n"
+                   "small-angle approximations, starting from the paper's answer; --method paper stops there.\n"
+                   "--robot: the robot description the test ran with (host_sim/robots); --params: the\n"
+                   "parameter block it ran with (overrides the robot's calibration). --out-params writes\n"
+                   "the new block (JSON as `odo-params show` prints it, or .bin) for `odo-calib write` or\n"
+                   "`odo-sim --params`.\n");
+            return 0;
+        }
+    }
+    if (parse_opts("umbmark", argc, argv, o, n) != 0) {
+        return EXIT_USAGE;
+    }
+    const char *returns_path = opt(o, n, "--returns"), *side = opt(o, n, "--side-mm"), *robot = opt(o, n, "--robot"),
+               *params = opt(o, n, "--params"), *method = opt(o, n, "--method"), *out = opt(o, n, "--out-params");
+    const int json = opt(o, n, "--json") != NULL;
+    if (returns_path == NULL || side == NULL || (robot == NULL && params == NULL)) {
+        fprintf(stderr, "%s umbmark: --returns, --side-mm and --robot (or --params) are required\n", k_prog);
+        return EXIT_USAGE;
+    }
+    calib_method_t m = CALIB_EXACT;
+    if (method != NULL && strcmp(method, "paper") == 0) {
+        m = CALIB_PAPER;
+    } else if (method != NULL && strcmp(method, "exact") != 0) {
+        fprintf(stderr, "%s umbmark: --method must be paper or exact, not '%s'\n", k_prog, method);
+        return EXIT_USAGE;
+    }
+    char *end = NULL;
+    errno = 0;
+    const double side_mm = strtod(side, &end);
+    if (end == side || *end != '\0' || errno != 0 || !isfinite(side_mm) || side_mm <= 0.0) {
+        fprintf(stderr, "%s umbmark: --side-mm must be a positive number of mm, not '%s'\n", k_prog, side);
+        return EXIT_FAIL;
+    }
+    odo_params_t in_force;
+    if (params_in_force("umbmark", robot, params, &in_force) != 0) {
+        return EXIT_FAIL;
+    }
+    static returns_t r;
+    char err[512];
+    if (returns_read(returns_path, &r, err, sizeof err) != 0) {
+        fprintf(stderr, "%s umbmark: %s\n", k_prog, err);
+        return EXIT_FAIL;
+    }
+    calib_result_t c;
+    if (calib_umbmark(&r, side_mm, &in_force, m, &c, err, sizeof err) != 0) {
+        fprintf(stderr, "%s umbmark: %s: %s\n", k_prog, returns_path, err);
+        return EXIT_FAIL;
+    }
+    if (out != NULL) {
+        odo_params_t np;
+        calib_apply(&in_force, &c, &np);
+        if (write_params(out, &np) != 0) {
+            return EXIT_FAIL;
+        }
+    }
+    if (json) {
+        print_calib_json(stdout, &c, returns_path, side_mm, out);
+    } else {
+        print_calib_table(stdout, &c);
+        if (out != NULL) {
+            printf("parameters written to %s\n", out);
+        }
+    }
+    return 0;
+}
+
+/* ---------------------------------------------------------------------------------------------
+ * write / read / verify
+ * ------------------------------------------------------------------------------------------- */
+
+static int help_if(int argc, char **argv, const char *text)
+{
+    for (int i = 0; i < argc; ++i) {
+        if (is_help(argv[i])) {
+            fputs(text, stdout);
+            return 1;
+        }
+    }
+    return 0;
+}
+
+static int cmd_write(int argc, char **argv)
+{
+    if (help_if(argc, argv,
+                "usage: odo-calib write --image FW --params P.json|P.bin [--out OUT] [--force]\n"
+                "\n"
+                "Replace the parameter block inside a firmware image: raw .bin (found by its magic), Intel\n"
+                "HEX, or ELF (section .odo_params). The image's block must have this tool's layout and\n"
+                "version (and a good CRC unless --force). The new block is encoded by the firmware's own\n"
+                "codec (CRC-32 recomputed) and written to OUT (default: FW itself) through a temporary\n"
+                "file that is read back before it is renamed into place; on any error FW and OUT keep\n"
+                "their old content.\n")) {
+        return 0;
+    }
+    opt_t o[] = {{"--image", 1, NULL}, {"--params", 1, NULL}, {"--out", 1, NULL}, {"--force", 0, NULL}};
+    const size_t n = sizeof o / sizeof o[0];
+    if (parse_opts("write", argc, argv, o, n) != 0) {
+        return EXIT_USAGE;
+    }
+    const char *image = opt(o, n, "--image"), *params = opt(o, n, "--params"), *out = opt(o, n, "--out");
+    if (image == NULL || params == NULL) {
+        fprintf(stderr, "%s write: --image and --params are required\n", k_prog);
+        return EXIT_USAGE;
+    }
+    char err[512];
+    odo_params_t p;
+    if (odo_params_file_load(params, &p, err, sizeof err) != 0) {
+        fprintf(stderr, "%s write: %s\n", k_prog, err);
+        return EXIT_FAIL;
+    }
+    img_t img;
+    if (img_load(image, &img, err, sizeof err) != 0) {
+        fprintf(stderr, "%s write: %s\n", k_prog, err);
+        return EXIT_FAIL;
+    }
+    if (img.status == ODO_PARAMS_ERR_CRC && opt(o, n, "--force") == NULL) {
+        fprintf(stderr, "%s write: %s: the block at 0x%llx has a bad CRC-32 (corrupted image?); --force to "
+                        "overwrite it anyway\n", k_prog, image, (unsigned long long)img.block_addr);
+        img_free(&img);
+        return EXIT_FAIL;
+    }
+    uint8_t block[ODO_PARAMS_SIZE];
+    (void)odo_params_encode(&p, block, sizeof block);
+    const int rc = img_write_patched(&img, block, out != NULL ? out : image, err, sizeof err);
+    if (rc != 0) {
+        fprintf(stderr, "%s write: %s\n", k_prog, err);
+    } else {
+        fprintf(stderr, "%s: wrote the parameter block (CRC-32 0x%08" PRIX32 ") at 0x%llx of %s image %s\n", k_prog,
+                odo_crc32(block, ODO_PARAMS_CRC_OFFSET), (unsigned long long)img.block_addr, img_format_name(img.fmt),
+                out != NULL ? out : image);
+    }
+    img_free(&img);
+    return rc == 0 ? 0 : EXIT_FAIL;
+}
+
+static int load_image_cmd(const char *cmd, int argc, char **argv, img_t *img, int *json)
+{
+    opt_t o[] = {{"--image", 1, NULL}, {"--json", 0, NULL}};
+    const size_t n = json != NULL ? 2 : 1;
+    if (parse_opts(cmd, argc, argv, o, n) != 0) {
+        return EXIT_USAGE;
+    }
+    if (opt(o, n, "--image") == NULL) {
+        fprintf(stderr, "%s %s: --image is required\n", k_prog, cmd);
+        return EXIT_USAGE;
+    }
+    if (json != NULL) {
+        *json = opt(o, n, "--json") != NULL;
+    }
+    char err[512];
+    if (img_load(opt(o, n, "--image"), img, err, sizeof err) != 0) {
+        fprintf(stderr, "%s %s: %s\n", k_prog, cmd, err);
+        return EXIT_FAIL;
+    }
+    return 0;
+}
+
+static int cmd_read(int argc, char **argv)
+{
+    if (help_if(argc, argv, "usage: odo-calib read --image FW [--json]\n\nPrint the parameter block of a firmware "
+                            "image (.bin, Intel HEX, ELF); --json in the shape `odo-params show` prints.\n")) {
+        return 0;
+    }
+    img_t img;
+    int json = 0;
+    const int rc = load_image_cmd("read", argc, argv, &img, &json);
+    if (rc != 0) {
+        return rc;
+    }
+    odo_params_t p;
+    const odo_params_status_t st = odo_params_decode(img.block, ODO_PARAMS_SIZE, &p);
+    if (st != ODO_PARAMS_OK) {
+        fprintf(stderr, "%s read: block at 0x%llx: %s\n", k_prog, (unsigned long long)img.block_addr,
+                odo_params_status_str(st));
+        img_free(&img);
+        return EXIT_FAIL;
+    }
+    if (json) {
+        odo_params_json_write(stdout, &p);
+    } else {
+        const odo_truck_params_t *t = &p.truck[0];
+        double cl = 0, cr = 0;
+        int32_t cl_q = 0, cr_q = 0;
+        (void)odo_umb_correction_factors(t->ed_q30, &cl_q, &cr_q);
+        cl = cl_q / Q30;
+        cr = cr_q / Q30;
+        printf("%s image, parameter block at 0x%llx, version %u, CRC-32 0x%08" PRIX32 "\n", img_format_name(img.fmt),
+               (unsigned long long)img.block_addr, ODO_PARAMS_VERSION,
+               (uint32_t)(img.block[124] | img.block[125] << 8 | img.block[126] << 16 | (uint32_t)img.block[127] << 24));
+        for (unsigned k = 0; k < ODO_TRUCKS; ++k) {
+            t = &p.truck[k];
+            (void)odo_umb_correction_factors(t->ed_q30, &cl_q, &cr_q);
+            cl = cl_q / Q30;
+            cr = cr_q / Q30;
+            printf("truck %c: Dn %.4f mm, b %.4f mm, counts/rev %.3f, Ed %.7f, Eb %.7f, Es %.7f (cL %.7f, cR %.7f, "
+                   "b_actual %.4f mm)\n", 'A' + k, t->wheel_diameter_nm / 1e6, t->wheelbase_nm / 1e6,
+                   t->counts_per_rev_milli / 1e3, t->ed_q30 / Q30, t->eb_q30 / Q30, t->es_q30 / Q30, cl, cr,
+                   t->wheelbase_nm / 1e6 * (t->eb_q30 / Q30));
+        }
+    }
+    img_free(&img);
+    return 0;
+}
+
+static int cmd_verify(int argc, char **argv)
+{
+    if (help_if(argc, argv, "usage: odo-calib verify --image FW\n\nCheck the parameter block of a firmware image as "
+                            "the firmware does at boot (magic, version, length, CRC-32, every range). Exit 0 iff "
+                            "the firmware would accept it.\n")) {
+        return 0;
+    }
+    img_t img;
+    const int rc = load_image_cmd("verify", argc, argv, &img, NULL);
+    if (rc != 0) {
+        return rc;
+    }
+    odo_params_t p;
+    const odo_params_status_t st = odo_params_decode(img.block, ODO_PARAMS_SIZE, &p);
+    if (st != ODO_PARAMS_OK) {
+        fprintf(stderr, "%s verify: %s image: block at 0x%llx: %s\n", k_prog, img_format_name(img.fmt),
+                (unsigned long long)img.block_addr, odo_params_status_str(st));
+        img_free(&img);
+        return EXIT_FAIL;
+    }
+    printf("ok: %s image, parameter block at 0x%llx, version %u, CRC-32 good, every field in range\n",
+           img_format_name(img.fmt), (unsigned long long)img.block_addr, ODO_PARAMS_VERSION);
+    img_free(&img);
+    return 0;
+}
+
+/* ---------------------------------------------------------------------------------------------
+ * export
+ * ------------------------------------------------------------------------------------------- */
+
+static int cmd_export(int argc, char **argv)
+{
+    if (help_if(argc, argv,
+                "usage: odo-calib export --params P.json|P.bin --format ros2\n"
+                "\n"
+                "Print truck A's calibration as a ros2_controllers diff_drive_controller parameter\n"
+                "fragment (YAML): wheel_separation_multiplier = Eb (000 Eq. 6.28),\n"
+                "left/right_wheel_radius_multiplier = cL/Es, cR/Es (Eqs. 6.33-6.35, App. B). Put it under\n"
+                "your controller's name in the controller manager's parameter file.\n")) {
+        return 0;
+    }
+    opt_t o[] = {{"--params", 1, NULL}, {"--format", 1, NULL}};
+    const size_t n = 2;
+    if (parse_opts("export", argc, argv, o, n) != 0) {
+        return EXIT_USAGE;
+    }
+    const char *params = opt(o, n, "--params"), *format = opt(o, n, "--format");
+    if (params == NULL || format == NULL) {
+        fprintf(stderr, "%s export: --params and --format are required\n", k_prog);
+        return EXIT_USAGE;
+    }
+    if (strcmp(format, "ros2") != 0) {
+        fprintf(stderr, "%s export: unknown format '%s' (ros2)\n", k_prog, format);
+        return EXIT_USAGE;
+    }
+    odo_params_t p;
+    char err[512];
+    if (odo_params_file_load(params, &p, err, sizeof err) != 0) {
+        fprintf(stderr, "%s export: %s\n", k_prog, err);
+        return EXIT_FAIL;
+    }
+    const odo_truck_params_t *t = &p.truck[0];
+    int32_t cl = 0, cr = 0;
+    (void)odo_umb_correction_factors(t->ed_q30, &cl, &cr);
+    const double es = t->es_q30 / Q30;
+    printf("# odo-calib export --format ros2, from %s (truck A)\n"
+           "# diff_drive_controller: wheel_separation = wheel_separation_multiplier * wheel_separation,\n"
+           "# wheel radius = *_wheel_radius_multiplier * wheel_radius. Nominal: wheel_separation %.6f m,\n"
+           "# wheel_radius %.6f m. Ed %.9f, Eb %.9f, Es %.9f.\n"
+           "diff_drive_controller:\n"
+           "  ros__parameters:\n"
+           "    wheel_separation_multiplier: %.9f\n"
+           "    left_wheel_radius_multiplier: %.9f\n"
+           "    right_wheel_radius_multiplier: %.9f\n",
+           params, t->wheelbase_nm / 1e9, t->wheel_diameter_nm / 2e9, t->ed_q30 / Q30, t->eb_q30 / Q30, es,
+           t->eb_q30 / Q30, cl / Q30 / es, cr / Q30 / es);
+    return 0;
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 2 || is_help(argv[1])) {
+        usage(argc < 2 ? stderr : stdout);
+        return argc < 2 ? EXIT_USAGE : 0;
+    }
+    const char *cmd = argv[1];
+    if (strcmp(cmd, "umbmark") == 0) {
+        return cmd_umbmark(argc - 2, argv + 2);
+    }
+    if (strcmp(cmd, "write") == 0) {
+        return cmd_write(argc - 2, argv + 2);
+    }
+    if (strcmp(cmd, "read") == 0) {
+        return cmd_read(argc - 2, argv + 2);
+    }
+    if (strcmp(cmd, "verify") == 0) {
+        return cmd_verify(argc - 2, argv + 2);
+    }
+    if (strcmp(cmd, "export") == 0) {
+        return cmd_export(argc - 2, argv + 2);
+    }
+    if (strcmp(cmd, "acceptance") == 0) {
+        return calib_acceptance_main(argc - 2, argv + 2);
+    }
+    fprintf(stderr, "%s: unknown command '%s'\n", k_prog, cmd);
+    usage(stderr);
+    return EXIT_USAGE;
+}

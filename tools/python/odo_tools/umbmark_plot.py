@@ -1,0 +1,121 @@
+"""UMBmark return-error plots (000_12e7709aa9cd375a.txt): the cw and ccw clusters of return
+position errors with their centres of gravity and r_cg (Fig. 3.4 style, Eqs. 3.1-3.3) and, given
+the runs after calibration, both on one set of axes (Fig. 6.5 style).
+
+Reads returns.csv files (host_sim/README.md contract) and writes one PNG; prints Emax,syst
+(Eq. 3.4) of each set.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import sys
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt
+import numpy as np
+
+COLUMNS = ["run", "direction", "x_abs_mm", "y_abs_mm", "theta_abs_deg", "x_calc_mm",
+           "y_calc_mm", "theta_calc_deg"]
+
+
+def read_returns(path: Path) -> dict[str, np.ndarray]:
+    """Return errors (000 Eq. 3.1) per direction: {"cw": (n, 2) array of (ex, ey) mm, ...}."""
+    with path.open(newline="") as f:
+        rows = [r for r in csv.reader(f) if r and not r[0].startswith("#")]
+    if not rows or rows[0] != COLUMNS:
+        raise ValueError(f"{path}:1: header must be {','.join(COLUMNS)}")
+    out: dict[str, list[tuple[float, float]]] = {"cw": [], "ccw": []}
+    for lineno, r in enumerate(rows[1:], start=2):
+        if len(r) != len(COLUMNS) or r[1] not in out:
+            raise ValueError(f"{path}:{lineno}: expected 8 fields with direction cw or ccw")
+        try:
+            v = [float(x) for x in r[2:]]
+        except ValueError as e:
+            raise ValueError(f"{path}:{lineno}: {e}") from None
+        if not np.all(np.isfinite(v)):
+            raise ValueError(f"{path}:{lineno}: values must be finite")
+        out[r[1]].append((v[0] - v[3], v[1] - v[4]))
+    return {d: np.array(p, dtype=float).reshape(-1, 2) for d, p in out.items()}
+
+
+def emax_syst(errors: dict[str, np.ndarray]) -> float:
+    """000 Eq. 3.4: the larger distance of the two centres of gravity from the origin."""
+    return max(float(np.hypot(*e.mean(axis=0))) for e in errors.values() if len(e))
+
+
+def draw(ax: plt.Axes, errors: dict[str, np.ndarray], label: str, filled: bool) -> None:
+    style = {"cw": ("o", "tab:blue"), "ccw": ("s", "tab:red")}
+    for d, e in errors.items():
+        if not len(e):
+            continue
+        marker, color = style[d]
+        ax.scatter(e[:, 0], e[:, 1], marker=marker, facecolors=color if filled else "none",
+                   edgecolors=color, label=f"{label} {d}")
+        cg = e.mean(axis=0)
+        ax.plot(*cg, marker="x", color=color, markersize=12, mew=2)
+        ax.plot([0, cg[0]], [0, cg[1]], color=color, lw=0.8, ls="--")
+        ax.annotate(f"c.g. {d} r={np.hypot(*cg):.0f} mm", cg, textcoords="offset points",
+                    xytext=(6, 6), fontsize=8, color=color)
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(
+        prog="odo-plot-umbmark",
+        description="Plot UMBmark return errors: cw/ccw clusters and centres of gravity "
+                    "(000 Fig. 3.4), before and after calibration (Fig. 6.5).")
+    ap.add_argument("--before", type=Path, required=True, help="returns.csv before calibration")
+    ap.add_argument("--after", type=Path, help="returns.csv after calibration")
+    ap.add_argument("--out", type=Path, required=True, help="output PNG")
+    ap.add_argument("--title", default="UMBmark return position errors")
+    args = ap.parse_args(argv)
+    try:
+        before = read_returns(args.before)
+        after = read_returns(args.after) if args.after else None
+    except (OSError, ValueError) as e:
+        print(f"odo-plot-umbmark: {e}", file=sys.stderr)
+        return 1
+    panels = 2 if after is not None else 1
+    fig, axes = plt.subplots(1, panels, figsize=(6.5 * panels, 6), squeeze=False)
+    ax = axes[0][0]
+    draw(ax, before, "before", filled=True)
+    ax.set_title(f"{args.title}\nbefore: Emax,syst {emax_syst(before):.1f} mm (000 Eq. 3.4)")
+    if after is not None:
+        ax2 = axes[0][1]
+        draw(ax2, before, "before", filled=False)
+        draw(ax2, after, "after", filled=True)
+        ax2.set_title(f"before {emax_syst(before):.1f} mm, after {emax_syst(after):.1f} mm "
+                      f"({emax_syst(before) / max(emax_syst(after), 1e-9):.0f}-fold)")
+    for a in axes[0]:
+        a.axhline(0, color="grey", lw=0.5)
+        a.axvline(0, color="grey", lw=0.5)
+        a.plot(0, 0, "k+", markersize=14)
+        a.set_aspect("equal", adjustable="datalim")
+        a.set_xlabel("ex = x_abs - x_calc [mm]")
+        a.set_ylabel("ey = y_abs - y_calc [mm]")
+        a.legend(fontsize=8, loc="best")
+        a.grid(True, lw=0.3)
+    fig.tight_layout()
+    tmp = args.out.with_name(args.out.name + ".tmp.png")
+    try:
+        fig.savefig(tmp, dpi=110)
+        tmp.replace(args.out)
+    except OSError as e:
+        print(f"odo-plot-umbmark: cannot write {args.out}: {e}", file=sys.stderr)
+        tmp.unlink(missing_ok=True)
+        return 1
+    finally:
+        plt.close(fig)
+    line = f"Emax,syst before {emax_syst(before):.1f} mm"
+    if after is not None:
+        line += f", after {emax_syst(after):.1f} mm"
+    print(f"odo-plot-umbmark: {line} -> {args.out}", file=sys.stderr)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
