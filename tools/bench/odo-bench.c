@@ -17,6 +17,7 @@
 #include "odo/odo_app.h"
 #include "odo_refcheck.h"
 #include "odo_synth.h"
+#include "replay_bench.h"
 #include "robot.h"
 #include "sil.h"
 #include "trig_accuracy.h"
@@ -32,24 +33,30 @@ static void usage(FILE *f)
             "  pos_err_mm_1km, heading_err_rad_1km  fixed point vs double after 1 km of mixed\n"
             "                                       driving (worst of 6 runs; targets 0.1, 1e-6)\n"
             "  sincos_max_abs_err, atan2_max_abs_err_rad  vs libm over 10^6 random inputs + edges\n"
+            "  ipec_step_instructions               the same with IPEC on (paper form, every tick)\n"
             "  step_instructions                    x86-64 instructions per 40 ms application\n"
             "                                       step for two trucks, counted by callgrind\n"
             "  sim_umbmark_10runs_s                 wall seconds for the 10-run UMBmark set of the\n"
             "                                       000 s. 4.6.2 robot at 1 ms physics, firmware in\n"
             "                                       the loop (target < 1 s on one core)\n"
             "  sim_realtime_factor                  simulated seconds per wall second in that set\n"
+            "  replay_ticks_per_s                   odo-replay's offline loop (parse, assemble, step,\n"
+            "                                       output lines) on a 1-hour clapper sim log\n"
+            "  replay_vs_python_can_ratio           its frames/s over python-can's CanutilsLogReader\n"
+            "                                       merely reading the same file (target >= 20)\n"
             "  --json   one JSON object on stdout (progress goes to stderr)\n"
             "  --quick  fewer samples (for smoke tests; figures are then indicative only)\n");
 }
 
 /// Hidden mode run under callgrind: KERNEL_STEPS application steps of a clapper (two trucks).
-static int run_kernel(void)
+static int run_kernel(int ipec)
 {
     static odo_app_t app;
     static odo_tick_output_t out;
     odo_params_t p;
     odo_params_defaults(&p);
     p.vehicle = ODO_VEHICLE_CLAPPER;
+    p.ipec_mode = (uint8_t)(ipec ? ODO_IPEC_PAPER : ODO_IPEC_OFF); /* --kernel-ipec: 002 Eqs. 9-16 */
     if (odo_app_init_params(&app, &p) != ODO_PARAMS_OK) {
         return 2;
     }
@@ -73,6 +80,15 @@ static int run_kernel(void)
             in.wheel[t].left_raw = (uint32_t)((uint64_t)c[t][0] & 0xFFFFFFU);
             in.wheel[t].right_raw = (uint32_t)((uint64_t)c[t][1] & 0xFFFFFFU);
         }
+        if (ipec) { /* a fresh, valid linkage sample every tick, so IPEC runs every tick */
+            in.link.rotary_present = in.link.linear_present = true;
+            in.link.rotary_seq = in.link.linear_seq = (uint8_t)i;
+            in.link.rotary_status = ODO_LINK_STATUS_ALPHA_VALID | ODO_LINK_STATUS_BETA_VALID;
+            in.link.linear_status = ODO_LINK_STATUS_LENGTH_VALID;
+            in.link.alpha_bam16 = (uint16_t)(i & 0x3FU) << 6;
+            in.link.beta_bam16 = (uint16_t)(0U - ((i & 0x3FU) << 6));
+            in.link.length_um = 1000000U;
+        }
         odo_app_step(&app, &in, &out);
         sink += out.frames[0].data[0];
     }
@@ -80,7 +96,7 @@ static int run_kernel(void)
 }
 
 /// Count instructions inside odo_app_step with callgrind. Returns -1 if valgrind is unavailable.
-static double step_instructions(char *tool, size_t tool_len)
+static double step_instructions(char *tool, size_t tool_len, const char *kernel)
 {
     char self[PATH_MAX];
     const ssize_t n = readlink("/proc/self/exe", self, sizeof self - 1U);
@@ -97,8 +113,8 @@ static double step_instructions(char *tool, size_t tool_len)
     char cmd[3 * PATH_MAX];
     snprintf(cmd, sizeof cmd,
              "valgrind --tool=callgrind --toggle-collect=odo_app_step --callgrind-out-file=%s "
-             "'%s' --kernel >/dev/null 2>&1",
-             out_file, self);
+             "'%s' %s >/dev/null 2>&1",
+             out_file, self, kernel);
     const int rc = system(cmd);
     double per_step = -1.0;
     FILE *f = (rc == 0) ? fopen(out_file, "r") : NULL;
@@ -172,7 +188,9 @@ int main(int argc, char **argv)
     int json = 0, quick = 0;
     for (int i = 1; i < argc; ++i) {
         if (strcmp(argv[i], "--kernel") == 0) {
-            return run_kernel();
+            return run_kernel(0);
+        } else if (strcmp(argv[i], "--kernel-ipec") == 0) {
+            return run_kernel(1);
         } else if (strcmp(argv[i], "--json") == 0) {
             json = 1;
         } else if (strcmp(argv[i], "--quick") == 0) {
@@ -207,10 +225,14 @@ int main(int argc, char **argv)
     odo_trig_accuracy(42U, quick ? 100000U : 1000000U, &sc, &at);
     fprintf(stderr, "odo-bench: instructions per step (callgrind) ...\n");
     char tool[160] = "";
-    const double instr = step_instructions(tool, sizeof tool);
+    const double instr = step_instructions(tool, sizeof tool, "--kernel");
+    const double ipec_instr = instr >= 0.0 ? step_instructions(tool, sizeof tool, "--kernel-ipec") : -1.0;
     fprintf(stderr, "odo-bench: 10-run UMBmark in the simulator ...\n");
     double sim_s = 0.0;
     const double sim_wall = sim_umbmark_10runs(&sim_s);
+    fprintf(stderr, "odo-bench: offline replay of a 1-hour clapper log vs python-can ...\n");
+    replay_bench_t rb;
+    const int rb_ok = replay_bench_run(quick ? 1 : 3, NULL, &rb) == 0;
 
     if (json) {
         printf("{\"pos_err_mm_1km\": %.6g, \"heading_err_rad_1km\": %.6g, "
@@ -222,15 +244,35 @@ int main(int argc, char **argv)
             printf("\"step_instructions\": null, \"step_instructions_tool\": \"valgrind not available\", ");
         }
         printf("\"step_instructions_trucks\": 2, ");
+        if (ipec_instr >= 0.0) {
+            printf("\"ipec_step_instructions\": %.0f, ", ipec_instr); /* two trucks + IPEC (paper form) */
+        } else {
+            printf("\"ipec_step_instructions\": null, ");
+        }
         if (sim_wall >= 0.0) {
             printf("\"sim_umbmark_10runs_s\": %.4f, \"sim_realtime_factor\": %.0f, \"sim_seconds\": %.1f, ",
                    sim_wall, sim_s / sim_wall, sim_s);
         } else {
             printf("\"sim_umbmark_10runs_s\": null, \"sim_realtime_factor\": null, ");
         }
+        if (rb_ok) { /* issue 6: replay throughput and the python-can reference */
+            printf("\"replay_ticks_per_s\": %.0f, \"replay_frames_per_s\": %.0f, \"replay_ticks\": %lu, "
+                   "\"replay_with_output_ticks_per_s\": %.0f, ",
+                   rb.ticks_per_s, rb.frames_per_s, rb.ticks, rb.with_output_ticks_per_s);
+            if (rb.ratio > 0.0) {
+                printf("\"python_can_frames_per_s\": %.0f, \"replay_vs_python_can_ratio\": %.1f, "
+                       "\"replay_ipec_ticks_per_s\": %.0f, \"replay_ipec_vs_python_can_ratio\": %.1f, ",
+                       rb.python_can_frames_per_s, rb.ratio, rb.ipec_ticks_per_s, rb.ipec_ratio);
+            } else {
+                printf("\"python_can_frames_per_s\": null, \"replay_vs_python_can_ratio\": null, ");
+            }
+        } else {
+            printf("\"replay_ticks_per_s\": null, \"replay_vs_python_can_ratio\": null, ");
+        }
         printf("\"targets\": {\"pos_err_mm_1km\": 0.1, "
                "\"heading_err_rad_1km\": 1e-06, \"sincos_max_abs_err\": 2e-08, "
-               "\"atan2_max_abs_err_rad\": 1e-07, \"sim_umbmark_10runs_s\": 1.0}}\n");
+               "\"atan2_max_abs_err_rad\": 1e-07, \"sim_umbmark_10runs_s\": 1.0, "
+               "\"replay_vs_python_can_ratio\": 20}}\n");
     } else {
         printf("fixed vs double, 1 km     position %.3g mm (target <= 0.1)  heading %.3g rad (<= 1e-6)\n",
                pos, head);
@@ -244,6 +286,14 @@ int main(int argc, char **argv)
         if (sim_wall >= 0.0) {
             printf("simulator, 10-run UMBmark  %.3f s wall for %.0f s simulated (x%.0f real time; target < 1 s)\n",
                    sim_wall, sim_s, sim_s / sim_wall);
+        }
+        if (rb_ok) {
+            printf("replay, 1-hour clapper log %.0f ticks/s, %.0f frames/s", rb.ticks_per_s, rb.frames_per_s);
+            if (rb.ratio > 0.0) {
+                printf("; python-can reading it %.0f frames/s (x%.1f; target >= 20)", rb.python_can_frames_per_s,
+                       rb.ratio);
+            }
+            printf("\n");
         }
     }
     const int ok = pos <= 0.1 && head <= 1e-6 && sc <= 2e-8 && at <= 1e-7;

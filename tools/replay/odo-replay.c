@@ -1,0 +1,454 @@
+/// odo-replay: run the firmware's 40 ms application step on recorded or live CAN sensor frames.
+///
+///   offline: odo-replay --log run.log --robot R.json [--params P.bin|P.json] [--ipec on|off] --out DIR
+///   live:    odo-replay --iface vcan0 --robot R.json ... [--out DIR] [--idle-exit S] [--no-send]
+///
+/// Both modes feed the same tick assembler (replay.h), so the same frames give the same outputs.
+/// DIR receives poses.csv, out.log (the firmware's output frames, candump -l) and summary.json,
+/// written to DIR.tmp.<pid> and renamed into place at the end: nothing half-written.
+#define _DEFAULT_SOURCE 1
+#include <dirent.h>
+#include <errno.h>
+#include <inttypes.h>
+#include <limits.h>
+#include <math.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "hal_log.h"
+#include "hal_socketcan.h"
+#include "odo/odo_can.h"
+#include "odo/odo_params.h"
+#include "params_json.h"
+#include "replay.h"
+#include "robot.h"
+
+#define MARKER ".odo-replay"
+#define PROGRESS_TICKS 25000U
+
+static void usage(FILE *f)
+{
+    fprintf(f,
+            "usage: odo-replay --log RUN.log  (--robot R.json | --params P) [options] --out DIR\n"
+            "       odo-replay --iface vcan0  (--robot R.json | --params P) [options] [--out DIR]\n"
+            "\n"
+            "Runs the firmware's 40 ms step on CAN sensor frames (WHEEL_COUNTS_A/B, LINK_ROTARY,\n"
+            "LINK_LINEAR; can/odometry.dbc) read from a candump -l log or a SocketCAN interface,\n"
+            "on the frames' timestamps (tick k collects the frames within half a period of\n"
+            "t0 + k * 40 ms). Live mode publishes the output frames on the interface.\n"
+            "\n"
+            "  --robot R.json     robot description (host_sim/robots/*.json) -> parameters\n"
+            "  --params P         parameter block, raw (P.bin) or JSON (P.json, odo-params show);\n"
+            "                     overrides --robot\n"
+            "  --ipec on|off      force IPEC on (paper mode, as odo-sim --ipec on) or off;\n"
+            "                     default: what the robot/parameters say (odo-sim's default is off)\n"
+            "  --out DIR          poses.csv, out.log (output frames, candump -l), summary.json\n"
+            "  --out-iface NAME   interface name written in out.log (default: the input's)\n"
+            "  --idle-exit S      live: exit S seconds after the last frame (default: run until\n"
+            "                     SIGINT/SIGTERM)\n"
+            "  --no-send          live: do not publish the output frames on the bus\n"
+            "  --margin-ms M      live: close a tick M ms after its last frame may arrive (default 5)\n"
+            "  --quiet            no progress on stderr\n"
+            "\n"
+            "Exit status: 0 done, 1 bad input (the message names file and line), 2 usage.\n");
+}
+
+typedef struct {
+    FILE          *csv;
+    FILE          *log;
+    char           iface[CANDUMP_IFACE_MAX + 1];
+    hal_socketcan_t *sc;      ///< live: publish here (NULL: offline or --no-send)
+    int            quiet;
+    int            io_error;
+    uint64_t       out_frames;
+} sink_t;
+
+static double q32_mm(int64_t v) { return (double)v / 4294967296.0; }
+static double q64_deg(uint64_t h) { return ldexp((double)h, -64) * 360.0; }
+
+static void on_tick(void *user, replay_t *r, uint64_t tick, const odo_tick_input_t *in,
+                    const odo_tick_output_t *out)
+{
+    sink_t *s = user;
+    char line[CANDUMP_LINE_MAX];
+    for (uint8_t k = 0U; k < out->n_frames; ++k) {
+        if (s->sc != NULL && !hal_socketcan_send(s->sc, &out->frames[k]) && r->app.tx_dropped != UINT32_MAX) {
+            r->app.tx_dropped++; /* counted; the tick goes on (hal.h hal_can_send) */
+        }
+        const size_t n = candump_format_line(line, in->t_us, s->iface, &out->frames[k]);
+        s->io_error |= fwrite(line, 1U, n, s->log) != n;
+        s->out_frames++;
+    }
+    const odo_pose_t *a = &out->pose[ODO_TRUCK_A], *b = &out->pose[ODO_TRUCK_B];
+    fprintf(s->csv, "%" PRIu64 ",%.6f,%.6f,%.6f,%.9f,%.6f,%.6f,%.9f,%" PRId32 ",%" PRId32 ",0x%05" PRIX32 "\n",
+            tick, (double)(tick * r->tick_us) / 1e6, q32_mm(a->x_mm_q32), q32_mm(a->y_mm_q32),
+            q64_deg(a->heading_q64), q32_mm(b->x_mm_q32), q32_mm(b->y_mm_q32), q64_deg(b->heading_q64),
+            out->ipec_dtheta_bam[0], out->ipec_dtheta_bam[1], out->faults);
+    if (!s->quiet && tick > 0U && tick % PROGRESS_TICKS == 0U) {
+        fprintf(stderr, "odo-replay: %" PRIu64 " ticks (%.0f s of log)\n", tick, (double)tick * r->tick_us / 1e6);
+    }
+}
+
+static volatile sig_atomic_t g_stop = 0;
+static void on_signal(int sig)
+{
+    (void)sig;
+    g_stop = 1;
+}
+
+/// Parameters from --params (a block) or --robot (the simulator's robot description).
+static int load_params(const char *robot, const char *params, odo_params_t *p)
+{
+    char err[512];
+    if (params != NULL) { /* a 128-byte block or its JSON form (odo-params show), by content */
+        if (odo_params_file_load(params, p, err, sizeof err) != 0) {
+            fprintf(stderr, "odo-replay: %s\n", err);
+            return -1;
+        }
+        return 0;
+    }
+    static sim_robot_t r;
+    if (sim_robot_parse_file(robot, &r, err, sizeof err) != 0 || sim_robot_to_params(&r, p, err, sizeof err) != 0) {
+        fprintf(stderr, "odo-replay: %s\n", err);
+        return -1;
+    }
+    return 0;
+}
+
+/// Remove a folder holding only files (our own outputs).
+static void remove_flat_dir(const char *dir)
+{
+    DIR *d = opendir(dir);
+    if (d != NULL) {
+        char path[PATH_MAX];
+        for (struct dirent *e; (e = readdir(d)) != NULL;) {
+            if (strcmp(e->d_name, ".") != 0 && strcmp(e->d_name, "..") != 0) {
+                snprintf(path, sizeof path, "%s/%s", dir, e->d_name);
+                remove(path);
+            }
+        }
+        closedir(d);
+    }
+    rmdir(dir);
+}
+
+/// DIR may be replaced only if it does not exist or holds a previous odo-replay output.
+static int out_dir_ok(const char *dir)
+{
+    struct stat sb;
+    if (stat(dir, &sb) != 0) {
+        return 1;
+    }
+    char marker[PATH_MAX];
+    snprintf(marker, sizeof marker, "%s/" MARKER, dir);
+    return S_ISDIR(sb.st_mode) && access(marker, F_OK) == 0;
+}
+
+static FILE *open_in(const char *dir, const char *name)
+{
+    char path[PATH_MAX];
+    snprintf(path, sizeof path, "%s/%s", dir, name);
+    return fopen(path, "w");
+}
+
+static void write_summary(FILE *f, const char *mode, const char *input, const replay_t *r,
+                          const hal_log_stats_t *ls, const hal_sc_stats_t *ss, const sink_t *s)
+{
+    const replay_stats_t *st = &r->stats;
+    fprintf(f, "{\"tool\": \"odo-replay\", \"mode\": \"%s\", \"input\": \"%s\", \"ticks\": %" PRIu64
+               ", \"frames\": %" PRIu64 ", \"sensor_frames\": %" PRIu64 ", \"ignored\": %" PRIu64
+               ", \"bad_dlc\": %" PRIu64 ", \"error_frames\": %" PRIu64 ", \"bus_off\": %" PRIu64
+               ", \"time_backwards\": %" PRIu64 ", \"late\": %" PRIu64 ", \"dup_dropped\": %" PRIu64
+               ", \"out_frames\": %" PRIu64 ", \"tx_dropped\": %" PRIu32 ", \"params_status\": \"%s\"",
+            mode, input, st->ticks, st->frames, st->sensor_frames, st->ignored, st->bad_dlc,
+            st->error_frames, st->bus_off, st->time_backwards, st->late, st->dup_dropped, s->out_frames,
+            r->app.tx_dropped, odo_params_status_str(r->app.params_status));
+    if (ls != NULL) {
+        fprintf(f, ", \"log_lines\": %" PRIu64 ", \"log_blank\": %" PRIu64, ls->lines, ls->blank);
+    }
+    if (ss != NULL) {
+        fprintf(f, ", \"bus\": {\"rx_frames\": %" PRIu64 ", \"rx_dropped\": %" PRIu64 ", \"tx_frames\": %" PRIu64
+                   ", \"tx_retries\": %" PRIu64 ", \"tx_dropped\": %" PRIu64 ", \"down_events\": %" PRIu64
+                   ", \"reopens\": %" PRIu64 "}",
+                ss->rx_frames, ss->rx_dropped, ss->tx_frames, ss->tx_retries, ss->tx_dropped, ss->down_events,
+                ss->reopens);
+    }
+    fprintf(f, "}\n");
+}
+
+/// Push every frame waiting on the socket. Returns 0, or 1 on a socket error (reported).
+static int drain(hal_socketcan_t *sc, replay_t *r, bool *seen, uint64_t *last_frame_us, bool *down, int quiet)
+{
+    for (;;) {
+        odo_can_frame_t f;
+        uint64_t t_us = 0U;
+        const hal_sc_status_t st = hal_socketcan_recv(sc, &f, &t_us);
+        if (st == HAL_SC_FRAME) {
+            replay_push(r, &f, t_us);
+            *seen = true;
+            *last_frame_us = hal_socketcan_now_us();
+            continue;
+        }
+        if (st == HAL_SC_DOWN && !*down) {
+            *down = true;
+            r->in.rx_faults |= ODO_FAULT_BUS_ERROR; /* the open tick learns the bus was lost */
+            if (!quiet) {
+                fprintf(stderr, "odo-replay: %s went down; waiting for it to come back\n", sc->ifname);
+            }
+        } else if (st == HAL_SC_ERROR) {
+            fprintf(stderr, "odo-replay: %s\n", sc->err);
+            return 1;
+        }
+        return 0;
+    }
+}
+
+/// Live loop: frames from the socket, ticks closed by later frames or by their deadline.
+static int run_live(hal_socketcan_t *sc, replay_t *r, double idle_exit_s, uint64_t margin_us, int quiet)
+{
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_signal;
+    sigaction(SIGINT, &sa, NULL);
+    sigaction(SIGTERM, &sa, NULL);
+    if (!quiet) {
+        fprintf(stderr, "odo-replay: listening on %s\n", sc->ifname);
+    }
+    bool seen = false, down = false;
+    uint64_t last_frame_us = hal_socketcan_now_us(), last_check_us = 0U;
+    while (!g_stop) {
+        uint64_t deadline = 0U;
+        const bool open_tick = replay_deadline_us(r, margin_us, &deadline);
+        uint64_t now = hal_socketcan_now_us();
+        int timeout_ms = 100;
+        if (open_tick) {
+            timeout_ms = deadline > now ? (int)((deadline - now + 999U) / 1000U) : 0;
+            timeout_ms = timeout_ms > 100 ? 100 : timeout_ms;
+        }
+        if (hal_socketcan_wait(sc, down ? 100 : timeout_ms) < 0) {
+            fprintf(stderr, "odo-replay: %s\n", sc->err);
+            return 1;
+        }
+        if (drain(sc, r, &seen, &last_frame_us, &down, quiet) != 0) {
+            return 1;
+        }
+        now = hal_socketcan_now_us();
+        if (replay_deadline_us(r, margin_us, &deadline) && now >= deadline) {
+            /* Frames queued while we looked at the clock were stamped before it: take them first. */
+            if (drain(sc, r, &seen, &last_frame_us, &down, quiet) != 0) {
+                return 1;
+            }
+            replay_close_tick(r);
+        }
+        if (down && now - last_check_us >= 100000U) {
+            last_check_us = now;
+            if (hal_socketcan_check_up(sc)) {
+                down = false;
+                if (!quiet) {
+                    fprintf(stderr, "odo-replay: %s is up again\n", sc->ifname);
+                }
+            }
+        }
+        if (idle_exit_s > 0.0 && seen && (double)(now - last_frame_us) > idle_exit_s * 1e6) {
+            break;
+        }
+    }
+    return 0;
+}
+
+int main(int argc, char **argv)
+{
+    const char *log = NULL, *iface = NULL, *robot = NULL, *params = NULL, *out = NULL, *out_iface = NULL;
+    int ipec = -1, quiet = 0, no_send = 0;
+    double idle_exit_s = 0.0, margin_ms = 5.0;
+    for (int i = 1; i < argc; ++i) {
+        const char *a = argv[i];
+        const int has = i + 1 < argc;
+        if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
+            usage(stdout);
+            return 0;
+        } else if (strcmp(a, "--quiet") == 0) {
+            quiet = 1;
+        } else if (strcmp(a, "--no-send") == 0) {
+            no_send = 1;
+        } else if (has && strcmp(a, "--log") == 0) {
+            log = argv[++i];
+        } else if (has && strcmp(a, "--iface") == 0) {
+            iface = argv[++i];
+        } else if (has && strcmp(a, "--robot") == 0) {
+            robot = argv[++i];
+        } else if (has && strcmp(a, "--params") == 0) {
+            params = argv[++i];
+        } else if (has && strcmp(a, "--out") == 0) {
+            out = argv[++i];
+        } else if (has && strcmp(a, "--out-iface") == 0) {
+            out_iface = argv[++i];
+        } else if (has && strcmp(a, "--ipec") == 0) {
+            ++i;
+            if (strcmp(argv[i], "on") != 0 && strcmp(argv[i], "off") != 0) {
+                fprintf(stderr, "odo-replay: --ipec must be on or off, not '%s'\n", argv[i]);
+                return 2;
+            }
+            ipec = strcmp(argv[i], "on") == 0;
+        } else if (has && (strcmp(a, "--idle-exit") == 0 || strcmp(a, "--margin-ms") == 0)) {
+            char *end = NULL;
+            const double v = strtod(argv[++i], &end);
+            if (end == argv[i] || *end != '\0' || !(v >= 0.0) || v > 86400.0) {
+                fprintf(stderr, "odo-replay: %s needs a number of %s >= 0, not '%s'\n", a,
+                        a[2] == 'i' ? "seconds" : "milliseconds", argv[i]);
+                return 2;
+            }
+            *(a[2] == 'i' ? &idle_exit_s : &margin_ms) = v;
+        } else {
+            fprintf(stderr, "odo-replay: unknown or incomplete argument '%s'\n\n", a);
+            usage(stderr);
+            return 2;
+        }
+    }
+    if ((log == NULL) == (iface == NULL)) {
+        fprintf(stderr, "odo-replay: give exactly one of --log FILE and --iface NAME\n\n");
+        usage(stderr);
+        return 2;
+    }
+    if (robot == NULL && params == NULL) {
+        fprintf(stderr, "odo-replay: --robot R.json or --params P.bin|P.json is required\n");
+        return 2;
+    }
+    if (log != NULL && out == NULL) {
+        fprintf(stderr, "odo-replay: --out DIR is required with --log\n");
+        return 2;
+    }
+    if (out != NULL && !out_dir_ok(out)) {
+        fprintf(stderr, "odo-replay: %s exists and is not an odo-replay output; not replacing it\n", out);
+        return 2;
+    }
+
+    odo_params_t p;
+    if (load_params(robot, params, &p) != 0) {
+        return 1;
+    }
+    if (ipec >= 0) {
+        p.ipec_mode = (uint8_t)(ipec ? ODO_IPEC_PAPER : ODO_IPEC_OFF);
+    }
+
+    /* Inputs first: a missing log or interface fails before anything is created. */
+    static hal_log_t reader;
+    static hal_socketcan_t sc;
+    sc.fd = -1;
+    static const uint32_t ids[] = {ODO_CAN_ID_WHEEL_COUNTS_A, ODO_CAN_ID_WHEEL_COUNTS_B, ODO_CAN_ID_LINK_ROTARY,
+                                   ODO_CAN_ID_LINK_LINEAR};
+    if (log != NULL && hal_log_open(&reader, log) != 0) {
+        fprintf(stderr, "odo-replay: %s\n", reader.err);
+        return 1;
+    }
+    if (iface != NULL && hal_socketcan_open(&sc, iface, ids, sizeof ids / sizeof ids[0]) != 0) {
+        fprintf(stderr, "odo-replay: %s\n", sc.err);
+        return 1;
+    }
+
+    char tmp[PATH_MAX] = "";
+    sink_t sink;
+    memset(&sink, 0, sizeof sink);
+    sink.quiet = quiet;
+    sink.sc = (iface != NULL && !no_send) ? &sc : NULL;
+    snprintf(sink.iface, sizeof sink.iface, "%s", out_iface != NULL ? out_iface : (iface != NULL ? iface : "can0"));
+    if (out != NULL) {
+        snprintf(tmp, sizeof tmp, "%s.tmp.%ld", out, (long)getpid());
+        if (mkdir(tmp, 0777) != 0) {
+            fprintf(stderr, "odo-replay: cannot create %s: %s\n", tmp, strerror(errno));
+            return 1;
+        }
+        sink.csv = open_in(tmp, "poses.csv");
+        sink.log = open_in(tmp, "out.log");
+    } else {
+        sink.csv = fopen("/dev/null", "w");
+        sink.log = fopen("/dev/null", "w");
+    }
+    if (sink.csv == NULL || sink.log == NULL) {
+        fprintf(stderr, "odo-replay: cannot create outputs in %s: %s\n", out != NULL ? tmp : "/dev/null",
+                strerror(errno));
+        return 1;
+    }
+    static char csv_buf[1 << 16], log_buf[1 << 16];
+    setvbuf(sink.csv, csv_buf, _IOFBF, sizeof csv_buf);
+    setvbuf(sink.log, log_buf, _IOFBF, sizeof log_buf);
+    fprintf(sink.csv, "tick,t_s,x_a_mm,y_a_mm,theta_a_deg,x_b_mm,y_b_mm,theta_b_deg,ipec_a_bam,ipec_b_bam,faults\n");
+
+    static replay_t r;
+    const odo_params_status_t ps = replay_init(&r, &p, on_tick, &sink);
+    if (ps != ODO_PARAMS_OK) {
+        fprintf(stderr, "odo-replay: warning: the firmware refused the parameters (%s); running on defaults\n",
+                odo_params_status_str(ps));
+    }
+
+    int rc = 0;
+    if (log != NULL) {
+        candump_line_t l;
+        hal_log_status_t st;
+        bool iface_set = out_iface != NULL;
+        while ((st = hal_log_next(&reader, &l)) == HAL_LOG_FRAME) {
+            if (!iface_set) {
+                snprintf(sink.iface, sizeof sink.iface, "%s", l.iface);
+                iface_set = true;
+            }
+            replay_push(&r, &l.frame, l.t_us);
+        }
+        if (st == HAL_LOG_ERROR) {
+            fprintf(stderr, "odo-replay: %s\n", reader.err);
+            rc = 1;
+        }
+        replay_finish(&r);
+    } else {
+        rc = run_live(&sc, &r, idle_exit_s, (uint64_t)llround(margin_ms * 1000.0), quiet);
+        replay_finish(&r);
+    }
+    if (r.stats.time_backwards > 0U && !quiet) {
+        fprintf(stderr, "odo-replay: warning: %" PRIu64 " frames stamped before the previous frame "
+                        "(flagged TIME_BACKWARDS)\n", r.stats.time_backwards);
+    }
+    if (r.stats.ignored > 0U && !quiet) {
+        fprintf(stderr, "odo-replay: %" PRIu64 " frames not consumed (unknown ID, RTR, extended or output "
+                        "frames) ignored\n", r.stats.ignored);
+    }
+
+    if (out != NULL) {
+        FILE *sf = open_in(tmp, "summary.json");
+        FILE *mk = open_in(tmp, MARKER);
+        if (sf != NULL) {
+            write_summary(sf, log != NULL ? "offline" : "live", log != NULL ? log : iface, &r,
+                          log != NULL ? &reader.stats : NULL, iface != NULL ? &sc.stats : NULL, &sink);
+        }
+        const int bad = sf == NULL || mk == NULL || fclose(sf) != 0 || fclose(mk) != 0;
+        const int bad2 = fclose(sink.csv) != 0 || fclose(sink.log) != 0 || sink.io_error;
+        if (rc == 0 && (bad || bad2)) {
+            fprintf(stderr, "odo-replay: writing %s failed: %s\n", tmp, strerror(errno));
+            rc = 1;
+        }
+        if (rc == 0) {
+            if (access(out, F_OK) == 0) {
+                remove_flat_dir(out);
+            }
+            if (rename(tmp, out) != 0) {
+                fprintf(stderr, "odo-replay: cannot rename %s to %s: %s\n", tmp, out, strerror(errno));
+                rc = 1;
+            }
+        }
+        if (rc != 0) {
+            remove_flat_dir(tmp);
+        }
+    } else {
+        fclose(sink.csv);
+        fclose(sink.log);
+    }
+    if (rc == 0 && !quiet) {
+        fprintf(stderr, "odo-replay: %" PRIu64 " ticks from %" PRIu64 " frames%s%s\n", r.stats.ticks,
+                r.stats.frames, out != NULL ? " -> " : "", out != NULL ? out : "");
+    }
+    hal_log_close(&reader);
+    hal_socketcan_close(&sc);
+    return rc;
+}
