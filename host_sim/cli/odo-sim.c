@@ -15,6 +15,7 @@
 #include <unistd.h>
 
 #include "candump.h"
+#include "params_json.h"
 #include "effects.h"
 #include "odo/odo_can.h"
 #include "robot.h"
@@ -27,7 +28,7 @@ static void usage(FILE *f)
 {
     fprintf(f,
             "usage: odo-sim --experiment NAME --vehicle labmate|clapper|set --scenario S.json --out DIR\n"
-            "               [--robot R.json] [--runs N] [--bumps N] [--ipec on|off] [--seed S] [--quiet]\n"
+            "               [--robot R.json] [--runs N] [--bumps N] [--ipec on|off|paper|estimator] [--seed S] [--quiet]\n"
             "       odo-sim --list-effects [--json]\n"
             "\n"
             "Experiments (000, 004): umbmark, umbmark-ext, straight-36m, rect-7x4. Closed paths run N\n"
@@ -35,7 +36,10 @@ static void usage(FILE *f)
             "--robot defaults to host_sim/robots/<vehicle>.json. --seed overrides the scenario's seed.\n"
             "Writes DIR/run-<dir>-NN.log (sensor frames, candump -l), DIR/run-<dir>-NN.truth.csv,\n"
             "DIR/returns.csv and DIR/summary.json. An existing DIR is replaced only if it holds a\n"
-            "previous odo-sim output.\n");
+            "previous odo-sim output.\n"
+            "--params P.json|P.bin: run the firmware with this parameter block's calibration (Ed, Eb,\n"
+            "Es per truck, e.g. from odo-calib umbmark --out-params); the world keeps the robot's true\n"
+            "geometry, and the block's nominal geometry must match the robot description's.\n");
 }
 
 typedef struct {
@@ -196,6 +200,7 @@ int main(int argc, char **argv)
     long runs = 5, bumps = -1;
     int ipec = 0, quiet = 0, seed_given = 0, list_effects = 0, list_json = 0;
     uint64_t seed = 0;
+    const char *params_path = NULL; /* --params: calibration for the firmware */
     for (int i = 1; i < argc; ++i) {
         const char *a = argv[i];
         const char *v = i + 1 < argc ? argv[i + 1] : NULL;
@@ -220,6 +225,8 @@ int main(int argc, char **argv)
             scenario_path = argv[++i];
         } else if (strcmp(a, "--robot") == 0) {
             robot_path = argv[++i];
+        } else if (strcmp(a, "--params") == 0) {
+            params_path = argv[++i];
         } else if (strcmp(a, "--out") == 0) {
             out = argv[++i];
         } else if (strcmp(a, "--runs") == 0 || strcmp(a, "--bumps") == 0) {
@@ -233,11 +240,13 @@ int main(int argc, char **argv)
             *(strcmp(a, "--runs") == 0 ? &runs : &bumps) = n;
         } else if (strcmp(a, "--ipec") == 0) {
             ++i;
-            if (strcmp(argv[i], "on") != 0 && strcmp(argv[i], "off") != 0) {
-                fprintf(stderr, "odo-sim: --ipec must be on or off, not '%s'\n", argv[i]);
+            /* on = paper (002 Eqs. 9-16 per tick); estimator = the sub-resolution form. */
+            if (strcmp(argv[i], "on") != 0 && strcmp(argv[i], "off") != 0 &&
+                strcmp(argv[i], "paper") != 0 && strcmp(argv[i], "estimator") != 0) {
+                fprintf(stderr, "odo-sim: --ipec must be on, off, paper or estimator, not '%s'\n", argv[i]);
                 return 2;
             }
-            ipec = strcmp(argv[i], "on") == 0;
+            ipec = strcmp(argv[i], "off") == 0 ? 0 : strcmp(argv[i], "estimator") == 0 ? 2 : 1;
         } else if (strcmp(a, "--seed") == 0) {
             errno = 0;
             seed = strtoull(argv[++i], &end, 10);
@@ -298,6 +307,29 @@ int main(int argc, char **argv)
         fprintf(stderr, "odo-sim: %s describes a %s, not a %s\n", robot_path, sim_vehicle_name(robot.vehicle),
                 vehicle_name);
         return 1;
+    }
+    if (params_path != NULL) {
+        /* The firmware boots with the block's calibration; the world's truth stays the robot's
+         * nominal geometry plus the scenario, so the geometry the block describes must match. */
+        odo_params_t cal, nominal;
+        if (odo_params_file_load(params_path, &cal, err, sizeof err) != 0 ||
+            sim_robot_to_params(&robot, &nominal, err, sizeof err) != 0) {
+            fprintf(stderr, "odo-sim: %s\n", err);
+            return 1;
+        }
+        for (unsigned t = 0; t < robot.n_trucks; ++t) {
+            const odo_truck_params_t *c = &cal.truck[t], *n = &nominal.truck[t];
+            if (c->wheel_diameter_nm != n->wheel_diameter_nm || c->wheelbase_nm != n->wheelbase_nm ||
+                c->counts_per_rev_milli != n->counts_per_rev_milli) {
+                fprintf(stderr, "odo-sim: %s: truck %c's nominal geometry (Dn, b, counts/rev) differs from %s\n",
+                        params_path, 'A' + t, robot_path);
+                return 1;
+            }
+            robot.truck[t].cal_ed = c->ed_q30 / 1073741824.0;
+            robot.truck[t].cal_eb = c->eb_q30 / 1073741824.0;
+            robot.truck[t].cal_es = c->es_q30 / 1073741824.0;
+            robot.truck[t].has_calibration = true;
+        }
     }
     if (sim_scenario_parse_file(scenario_path, &scenario, err, sizeof err) != 0) {
         fprintf(stderr, "odo-sim: %s\n", err);

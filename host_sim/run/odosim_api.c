@@ -128,6 +128,94 @@ int odosim_run(const odosim_setup_t *s, const char *experiment, int ccw, int bum
     return 0;
 }
 
+typedef struct {
+    odosim_tick_row_ex_t *rows;
+    size_t                capacity, n;
+    odosim_event_t       *ev;
+    size_t                ev_capacity, n_ev;
+} collect_ex_t;
+
+static void collect_ex(void *user, const sim_tick_t *tk)
+{
+    collect_ex_t *c = user;
+    for (size_t i = 0; i < tk->n_events; ++i, c->n_ev++) {
+        if (c->ev != NULL && c->n_ev < c->ev_capacity) {
+            const sim_bump_event_t *e = &tk->events[i];
+            c->ev[c->n_ev] = (odosim_event_t){e->t_s, e->x_mm, e->y_mm, e->height_mm, e->at_distance_mm,
+                                              e->truck, e->wheel};
+        }
+    }
+    if (c->rows != NULL && c->n < c->capacity) {
+        odosim_tick_row_ex_t *r = &c->rows[c->n];
+        memset(r, 0, sizeof *r);
+        r->t_s = tk->t_s;
+        r->t_us = tk->input->t_us;
+        for (unsigned t = 0; t < 2; ++t) {
+            r->truth[t][0] = tk->truth[t].x_mm;
+            r->truth[t][1] = tk->truth[t].y_mm;
+            r->truth[t][2] = tk->truth[t].theta_rad;
+            r->counts[t][0] = tk->input->wheel[t].left_raw;
+            r->counts[t][1] = tk->input->wheel[t].right_raw;
+            r->wheel_seq[t] = tk->input->wheel[t].seq;
+            r->wheel_status[t] = tk->input->wheel[t].status;
+            r->wheel_present[t] = tk->input->wheel[t].present ? 1U : 0U;
+        }
+        r->link_true[0] = tk->link.alpha_rad;
+        r->link_true[1] = tk->link.beta_rad;
+        r->link_true[2] = tk->link.length_mm;
+        const odo_link_input_t *l = &tk->input->link;
+        r->rotary_present = l->rotary_present ? 1U : 0U;
+        r->linear_present = l->linear_present ? 1U : 0U;
+        r->rotary_status = l->rotary_status;
+        r->linear_status = l->linear_status;
+        r->rotary_seq = l->rotary_seq;
+        r->linear_seq = l->linear_seq;
+        r->alpha_bam16 = l->alpha_bam16;
+        r->beta_bam16 = l->beta_bam16;
+        r->length_um = l->length_um;
+        r->n_events = (uint32_t)tk->n_events;
+    }
+    c->n++;
+}
+
+int odosim_run_ex(const odosim_setup_t *s, const odosim_run_opts_t *o, odosim_tick_row_ex_t *rows,
+                  size_t capacity, odosim_event_t *events, size_t ev_capacity, size_t *n_events,
+                  odosim_result_t *result, char *err, size_t errlen)
+{
+    if (s == NULL || o == NULL || o->experiment == NULL || result == NULL) {
+        snprintf(err, errlen, "NULL argument");
+        return -1;
+    }
+    const sim_hidden_t hidden = {o->motor_tau_s, o->diam_var_amp, o->diam_var_period_s, o->diam_drift_per_s,
+                                 o->backlash_rad};
+    const sim_run_config_t cfg = {.robot = &s->robot, .scenario = &s->scenario, .experiment = o->experiment,
+                                  .ccw = o->ccw ? 1 : 0, .bumps = o->bumps,
+                                  .bump_height_mm = o->bump_height_mm > 0.0 ? o->bump_height_mm : 10.0,
+                                  .ipec = o->ipec ? 1 : 0, .seed = o->seed, .run_index = o->run_index,
+                                  .physics_dt_s = o->physics_dt_s, .hidden = &hidden};
+    collect_ex_t c = {rows, capacity, 0, events, ev_capacity, 0};
+    sim_return_t ret;
+    if (sim_run(&cfg, collect_ex, &c, &ret, err, errlen) != 0) {
+        return -1;
+    }
+    memset(result, 0, sizeof *result);
+    result->x_abs_mm = ret.x_abs_mm;
+    result->y_abs_mm = ret.y_abs_mm;
+    result->theta_abs_deg = ret.theta_abs_deg;
+    result->x_calc_mm = ret.x_calc_mm;
+    result->y_calc_mm = ret.y_calc_mm;
+    result->theta_calc_deg = ret.theta_calc_deg;
+    result->ex_mm = ret.ex_mm;
+    result->ey_mm = ret.ey_mm;
+    result->etheta_deg = ret.etheta_deg;
+    result->t_end_s = ret.t_end_s;
+    result->n_ticks = c.n;
+    if (n_events != NULL) {
+        *n_events = c.n_ev;
+    }
+    return 0;
+}
+
 char *odosim_effects_json(void)
 {
     char *buf = NULL;

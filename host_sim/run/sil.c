@@ -76,6 +76,9 @@ static int setup(sil_state_t *st, const sim_run_config_t *cfg, char *err, size_t
     if (sim_world_init(&st->world, r, cfg->scenario, cfg->seed, err, errlen) != 0) {
         return -1;
     }
+    if (cfg->hidden != NULL && sim_world_set_hidden(&st->world, cfg->hidden, err, errlen) != 0) {
+        return -1;
+    }
     if (sim_program_build(cfg->experiment, cfg->ccw, cfg->bumps, cfg->bump_height_mm, cfg->run_index,
                           &st->prog, err, errlen) != 0) {
         return -1;
@@ -102,7 +105,8 @@ static int setup(sil_state_t *st, const sim_run_config_t *cfg, char *err, size_t
     if (sim_robot_to_params(r, &p, err, errlen) != 0) {
         return -1;
     }
-    p.ipec_mode = (uint8_t)(cfg->ipec ? ODO_IPEC_PAPER : ODO_IPEC_OFF);
+    /* cfg->ipec: 0 off, 1 the paper's per-tick form, 2 the sub-resolution estimator. */
+    p.ipec_mode = (uint8_t)(cfg->ipec == 2 ? ODO_IPEC_ESTIMATOR : cfg->ipec ? ODO_IPEC_PAPER : ODO_IPEC_OFF);
     /* Boot like the target: from an encoded parameter block. */
     uint8_t block[ODO_PARAMS_SIZE];
     (void)odo_params_encode(&p, block, sizeof block);
@@ -205,10 +209,12 @@ int sim_run(const sim_run_config_t *cfg, sim_tick_fn on_tick, void *user, sim_re
                 pose[t][1] = q32_mm(pt->y_mm_q32);
                 pose[t][2] = q64_rad(pt->heading_q64);
             }
+            /* An absolute encoder's code k covers [k, k+1) steps: steer on its centre. */
+            const double half_step = M_PI / ldexp(1.0, (int)st->app.params.link.rotary_bits);
             const sim_link_meas_t link = {
                 .length_mm = st->in.link.length_um / 1000.0,
-                .alpha_rad = (int16_t)st->in.link.alpha_bam16 * (M_PI / 32768.0),
-                .beta_rad = (int16_t)st->in.link.beta_bam16 * (M_PI / 32768.0),
+                .alpha_rad = (int16_t)st->in.link.alpha_bam16 * (M_PI / 32768.0) + half_step,
+                .beta_rad = (int16_t)st->in.link.beta_bam16 * (M_PI / 32768.0) + half_step,
             };
             running = sim_clapper_follower_step(&st->follow2, (const double(*)[3])pose, &link, cmd) && running;
         } else {

@@ -24,10 +24,11 @@ typedef struct {
     int                   ccw;        ///< direction of closed paths
     int                   bumps;      ///< < 0: the experiment's default
     double                bump_height_mm;
-    int                   ipec;       ///< 1: IPEC on (firmware ipec_mode), 0: off
+    int                   ipec;       ///< firmware ipec_mode: 0 off, 1 paper (per tick), 2 estimator
     uint64_t              seed;       ///< roughness etc. for this run
     unsigned              run_index;  ///< 0-based within its direction
     double                physics_dt_s; ///< 0: SIM_WORLD_DEFAULT_DT_S
+    const sim_hidden_t   *hidden;     ///< out-of-catalog truth (world.h); NULL: none (odo-gap blind)
 } sim_run_config_t;
 
 /// What the per-tick callback sees. Pointers are valid during the callback only.

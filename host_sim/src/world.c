@@ -328,15 +328,74 @@ static double slip_factor(const sim_world_t *w, unsigned t, double cmd, double p
     return fabs(cmd) >= fabs(prev) ? 1.0 - s : 1.0 / (1.0 - s);
 }
 
-static void step_driven(sim_world_t *w, unsigned t, double dt, const double cmd[2])
+int sim_world_set_hidden(sim_world_t *w, const sim_hidden_t *h, char *err, size_t errlen)
+{
+    if (w == NULL || h == NULL) {
+        return fail(err, errlen, "sim_world_set_hidden: NULL argument");
+    }
+    const double v[5] = {h->motor_tau_s, fabs(h->diam_var_amp), h->diam_var_period_s,
+                         fabs(h->diam_drift_per_s), h->backlash_rad};
+    for (size_t i = 0; i < 5; ++i) {
+        if (!isfinite(v[i]) || v[i] < 0.0) {
+            return fail(err, errlen, "hidden effect %zu: %g is not a finite non-negative value", i, v[i]);
+        }
+    }
+    if (fabs(h->diam_var_amp) >= 0.5 || (h->diam_var_amp != 0.0 && !(h->diam_var_period_s > 0.0))) {
+        return fail(err, errlen, "hidden diameter variation: |amp| < 0.5 and a positive period needed");
+    }
+    w->hidden = *h;
+    return 0;
+}
+
+/* Hidden time-varying diameter: the factor on the true radius at time t. */
+static double hidden_radius_factor(const sim_world_t *w)
+{
+    double f = 1.0;
+    if (w->hidden.diam_var_amp != 0.0) {
+        f += w->hidden.diam_var_amp * sin(2.0 * M_PI * w->t_s / w->hidden.diam_var_period_s);
+    }
+    if (w->hidden.diam_drift_per_s != 0.0) {
+        f += w->hidden.diam_drift_per_s * w->t_s;
+    }
+    return f > 0.1 ? f : 0.1;
+}
+
+/* Hidden backlash: the motor's rotation dphi moves through the gear play first; returns the
+ * wheel's rotation. play_rad starts at 0 (teeth against the backward flank), so even the first
+ * forward move takes up the play, as a real gearbox at rest might. */
+static double hidden_backlash(const sim_world_t *w, sim_wheel_state_t *ws, double dphi)
+{
+    const double bl = w->hidden.backlash_rad;
+    if (!(bl > 0.0)) {
+        return dphi;
+    }
+    double p = ws->play_rad + dphi, rot = 0.0;
+    if (p > bl) {
+        rot = p - bl;
+        p = bl;
+    } else if (p < 0.0) {
+        rot = p;
+        p = 0.0;
+    }
+    ws->play_rad = p;
+    return rot;
+}
+
+static void step_driven(sim_world_t *w, unsigned t, double dt, const double cmd_in[2])
 {
     sim_truck_state_t *ts = &w->truck[t];
-    double du[2];
+    double du[2], cmd[2] = {cmd_in[0], cmd_in[1]};
+    const double rf = hidden_radius_factor(w);
     for (unsigned wh = 0; wh < 2U; ++wh) {
         sim_wheel_state_t *ws = &ts->wheel[wh];
+        if (w->hidden.motor_tau_s > 0.0) { /* hidden controller dynamics: the wheel lags */
+            ws->v_motor_mm_s += (cmd[wh] - ws->v_motor_mm_s) * (1.0 - exp(-dt / w->hidden.motor_tau_s));
+            cmd[wh] = ws->v_motor_mm_s;
+        }
         const double dphi = cmd[wh] / ts->r_nominal_mm * dt; /* the motor follows the command */
         ws->phase_rad += dphi;
-        const double arc = dphi * ws->radius_mm * slip_factor(w, t, cmd[wh], ws->cmd_prev_mm_s, dt);
+        const double wrot = hidden_backlash(w, ws, dphi);
+        const double arc = wrot * ws->radius_mm * rf * slip_factor(w, t, cmd[wh], ws->cmd_prev_mm_s, dt);
         ws->cmd_prev_mm_s = cmd[wh];
         const double hor = driven_progress(ws, fabs(arc));
         du[wh] = arc < 0.0 ? -hor : hor;

@@ -87,11 +87,27 @@ typedef struct {
     double          progress_mm; ///< rotation arc (driven wheel) or horizontal (passive) so far
 } sim_active_bump_t;
 
+/// Hidden effects: truth the effects catalog deliberately does not list, so the diagnosis has no
+/// hypothesis for them (the blind check's out-of-catalog cases), plus the controller dynamics that
+/// make a "real" run higher fidelity than the diagnosis model. Never read from a scenario file;
+/// set only through sim_world_set_hidden (libodosim: odosim_run_ex). All zero = off, and then the
+/// world is bit-identical to a world without this struct. Driven wheels only.
+typedef struct {
+    double motor_tau_s;        ///< first-order lag of each wheel's speed behind its command (s)
+    double diam_var_amp;       ///< time-varying wheel diameter: D(t) = D (1 + amp sin(2 pi t / T))
+    double diam_var_period_s;  ///< T of the above (s); both wheels of a truck in phase
+    double diam_drift_per_s;   ///< and/or a linear drift D(t) = D (1 + drift t) (tyre warming)
+    double backlash_rad;       ///< gear backlash at the wheel: after a reversal the motor (and its
+                               ///< encoder) turns this much before the wheel follows
+} sim_hidden_t;
+
 typedef struct {
     double   radius_mm;     ///< true rolling radius
     double   phase_rad;     ///< cumulative rotation angle, forward positive
     double   odometer_mm;   ///< cumulative |horizontal travel| of the contact point
     double   cmd_prev_mm_s; ///< last command (slip)
+    double   v_motor_mm_s;  ///< hidden motor lag: the wheel's actual surface speed command
+    double   play_rad;      ///< hidden backlash: position in the gear play, [0, backlash]
     size_t   n_pending;
     struct { double at_mm, height_mm; } pending[SIM_WORLD_MAX_PENDING]; ///< ascending at_mm
     size_t   n_active;
@@ -117,6 +133,7 @@ typedef struct {
     uint64_t          seed;
     double            t_s;
     sim_truck_state_t truck[ODO_TRUCKS];
+    sim_hidden_t      hidden;         ///< out-of-catalog truth (all zero: off)
     unsigned long     link_clamps;    ///< steps in which the clapper linkage hit a stop
     bool              clamped_last;   ///< the last step did
     unsigned long     bumps_dropped;  ///< bumps lost to full queues (should stay 0)
@@ -133,6 +150,11 @@ typedef struct {
 /// compression makes non-positive, or a scenario bump the vehicle cannot take.
 int sim_world_init(sim_world_t *w, const sim_robot_t *robot, const sim_scenario_t *sc, uint64_t seed,
                    char *err, size_t errlen);
+
+/// Switch the hidden (out-of-catalog) effects on; call after sim_world_init, before stepping.
+/// Returns 0, or -1 with a message for a negative or non-finite value, |amp| or |drift t| that
+/// would make a radius non-positive, or a zero period with a non-zero amplitude.
+int sim_world_set_hidden(sim_world_t *w, const sim_hidden_t *h, char *err, size_t errlen);
 
 /// Place the vehicle rigidly at a pose (truck A), the other truck straight behind. Keeps time,
 /// encoder phases, odometers and bumps.

@@ -1,0 +1,38 @@
+"""Shared helpers of the odo-gap / odo-import tests (not a test module)."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+SRC = Path(os.environ.get("ODO_SOURCE_DIR", Path(__file__).resolve().parents[2]))
+BUILD = Path(os.environ.get("ODO_BUILD_DIR", SRC / "build" / "host"))
+PY = sys.executable
+
+
+def env() -> dict:
+    e = dict(os.environ)
+    e["ODO_SOURCE_DIR"] = str(SRC)
+    e["ODO_BUILD_DIR"] = str(BUILD)
+    e["PYTHONPATH"] = str(SRC / "tools" / "python") + os.pathsep + e.get("PYTHONPATH", "")
+    return e
+
+
+def odo_gap(*args: str) -> subprocess.CompletedProcess:
+    return subprocess.run(
+        [PY, "-m", "odo_tools.gap.cli", *args], env=env(), capture_output=True, text=True,
+        timeout=600)
+
+
+def odo_import(*args: str) -> subprocess.CompletedProcess:
+    return subprocess.run([PY, "-m", "odo_tools.importer", *args], env=env(), capture_output=True,
+                          text=True, timeout=600)
+
+
+def odo_sim(scenario: str, out: Path, runs: int = 1, experiment: str = "umbmark") -> None:
+    subprocess.run([str(BUILD / "bin" / "odo-sim"), "--quiet", "--experiment", experiment,
+                    "--vehicle", "labmate", "--scenario",
+                    str(SRC / "host_sim/scenarios" / scenario),
+                    "--runs", str(runs), "--out", str(out)], check=True, timeout=300)

@@ -1,0 +1,99 @@
+"""odo-gap diagnose on bad input (issue 7): a clear error naming the file (and line), a non-zero
+exit, and no partial report."""
+
+from __future__ import annotations
+
+import json
+import shutil
+from pathlib import Path
+
+import pytest
+from gap_support import SRC, odo_gap, odo_sim
+
+LABMATE = str(SRC / "host_sim/robots/labmate.json")
+
+
+@pytest.fixture(scope="module")
+def good(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    d = tmp_path_factory.mktemp("good") / "real"
+    odo_sim("effect-ed.json", d, runs=1)
+    return d
+
+
+def copy(good: Path, tmp: Path) -> Path:
+    d = tmp / "real"
+    shutil.copytree(good, d)
+    return d
+
+
+def fails(real: Path, tmp: Path, *expect: str, robot: str = LABMATE, extra=()) -> None:
+    out = tmp / "report"
+    r = odo_gap("diagnose", "--real", str(real), "--robot", robot, "--out", str(out), "--quiet",
+                *extra)
+    assert r.returncode != 0, r.stderr
+    for e in expect:
+        assert e in r.stderr, (e, r.stderr)
+    assert not out.exists() and not list(tmp.glob("report.tmp.*")), "partial report left"
+
+
+def test_missing_folder(tmp_path: Path) -> None:
+    fails(tmp_path / "nope", tmp_path, "nope", "not a folder")
+
+
+def test_unreadable_log(good: Path, tmp_path: Path) -> None:
+    d = copy(good, tmp_path)
+    (d / "run-cw-01.log").write_bytes(b"\xff\xfe\x00garbage\n")
+    fails(d, tmp_path, "run-cw-01.log")
+
+
+def test_log_line_that_is_not_candump(good: Path, tmp_path: Path) -> None:
+    d = copy(good, tmp_path)
+    p = d / "run-ccw-01.log"
+    lines = p.read_text().splitlines()
+    lines[6] = "this is not a frame"
+    p.write_text("\n".join(lines) + "\n")
+    fails(d, tmp_path, "run-ccw-01.log:7:", "candump")
+
+
+def test_log_without_wheel_counts(good: Path, tmp_path: Path) -> None:
+    d = copy(good, tmp_path)
+    p = d / "run-cw-01.log"
+    p.write_text("".join(ln.replace(" 110#", " 180#") + "\n" for ln in p.read_text().splitlines()))
+    fails(d, tmp_path, "run-cw-01.log", "WHEEL_COUNTS_A")
+
+
+@pytest.mark.parametrize("what,expect", [("nan", "non-finite"), ("back", "does not increase"),
+                                         ("gap", "gap of")])
+def test_bad_truth(good: Path, tmp_path: Path, what: str, expect: str) -> None:
+    d = copy(good, tmp_path)
+    p = d / "run-ccw-01.truth.csv"
+    lines = p.read_text().splitlines()
+    k = 500
+    if what == "nan":
+        f = lines[k].split(",")
+        f[2] = "nan"
+        lines[k] = ",".join(f)
+    elif what == "back":
+        lines[k], lines[k + 1] = lines[k + 1], lines[k]
+    else:
+        del lines[k: k + 30]
+    p.write_text("\n".join(lines) + "\n")
+    line = k + 1 if what != "back" else k + 2
+    fails(d, tmp_path, f"run-ccw-01.truth.csv:{line}:", expect)
+
+
+def test_robot_that_does_not_match_the_logs(good: Path, tmp_path: Path) -> None:
+    clapper = str(SRC / "host_sim/robots/clapper.json")
+    fails(good, tmp_path, "run-ccw-01.log", "WHEEL_COUNTS_B", robot=clapper)
+    r = json.loads(Path(LABMATE).read_text())
+    r["tick_ms"] = 50
+    rp = tmp_path / "slow.json"
+    rp.write_text(json.dumps(r))
+    fails(good, tmp_path, "run-ccw-01.log:1:", "tick_ms 50", robot=str(rp))
+
+
+def test_mode_without_its_frames(good: Path, tmp_path: Path) -> None:
+    fails(good, tmp_path, "mode linkage needs", extra=("--mode", "linkage"))
+    d = copy(good, tmp_path)
+    (d / "returns.csv").unlink()
+    fails(d, tmp_path, "mode returns needs", extra=("--mode", "returns"))

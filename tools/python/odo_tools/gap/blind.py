@@ -1,0 +1,547 @@
+"""odo-gap blind: the withheld-effect check (issue 7 item 3).
+
+A generator draws each case's truth (none; one catalog effect; a pair; or an effect outside the
+catalog: a time-varying wheel diameter or a gear backlash, host_sim's hidden effects) and its size,
+simulates "real" runs at higher fidelity than the diagnosis model (1 ms physics with continuous
+bump profiles, motor lag behind the controller's commands, motion-capture noise on the truth,
+measurement noise on the return poses), and writes only the recorded data into a case folder
+outside OUT. The key goes to OUT/keys/, which the diagnosing processes are forbidden to open (an
+audit hook in every worker refuses it; tests/python/test_gap_blind.py proves it). Each case is
+then diagnosed in every evidence mode its data allow, and scored.
+"""
+
+from __future__ import annotations
+
+import ctypes as C
+import json
+import math
+import multiprocessing as mp
+import os
+import shutil
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+from .io import ID_LINEAR, ID_ROTARY, encode_payload, source_dir, write_candump
+from .simlib import Event, Opts, Result, RowEx, lib
+
+TRUTH_NOISE_MM, TRUTH_NOISE_RAD = 0.3, 3e-4  # motion capture
+RETURN_NOISE_MM, RETURN_NOISE_DEG = 1.0, 0.02  # tape measure / compass at the end of a run
+PLAN = [("umbmark", 0, 3), ("umbmark", 1, 3), ("rect-7x4", 0, 2), ("rect-7x4", 1, 2)]
+PRIMARY = {
+    "ed": "ed.value",
+    "eb": "eb.value",
+    "es": "es.value",
+    "bumps": "bumps.height_mm",
+    "roughness": "roughness.max_height_mm",
+    "slip": "slip.k_per_m_s2",
+    "skid": "skid.k_s",
+    "rotary_bias": "rotary_bias.alpha_deg",
+    "link_bias": "link_bias.const_mm",
+}
+NEUTRAL = {"ed.value": 1.0, "eb.value": 1.0, "es.value": 1.0}
+
+
+def draw_effect(rng: np.random.Generator, name: str, vehicle: str) -> dict:
+    """One catalog effect with a random size, as scenario parameters."""
+    sgn = rng.choice([-1.0, 1.0])
+    if name in ("ed",):
+        return {"ed.value": 1.0 + sgn * rng.uniform(0.002, 0.01)}
+    if name in ("eb", "es"):
+        return {f"{name}.value": 1.0 + sgn * rng.uniform(0.005, 0.03)}
+    if name == "bumps":
+        return {
+            "bumps.height_mm": float(rng.uniform(4.0, 15.0)),
+            "_n_bumps": int(rng.integers(3, 9)),
+        }
+    if name == "roughness":
+        return {"roughness.max_height_mm": float(rng.uniform(1.0, 4.0))}
+    if name == "slip":
+        return {"slip.k_per_m_s2": float(rng.uniform(0.3, 1.0))}
+    if name == "skid":
+        return {"skid.k_s": float(rng.uniform(0.05, 0.3))}
+    if name == "rotary_bias":
+        p = {"rotary_bias.alpha_deg": sgn * float(rng.uniform(0.7, 3.0))}
+        if vehicle == "clapper":
+            p["rotary_bias.beta_deg"] = float(rng.choice([-1, 1]) * rng.uniform(0.7, 3.0))
+        return p
+    if name == "link_bias":
+        return {"link_bias.const_mm": sgn * float(rng.uniform(2.0, 10.0))}
+    raise ValueError(name)
+
+
+def catalog_choices(vehicle: str) -> list[str]:
+    c = ["ed", "eb", "es", "bumps", "roughness", "slip", "skid"]
+    if vehicle != "labmate":
+        c.append("rotary_bias")
+    if vehicle == "clapper":
+        c.append("link_bias")
+    return c
+
+
+def draw_case(rng: np.random.Generator, k: int) -> dict:
+    vehicle = str(rng.choice(["labmate", "labmate", "labmate", "clapper", "set"]))
+    kind = str(
+        rng.choice(["none", "single", "single", "single", "single", "single", "pair", "ooc", "ooc"])
+    )
+    case = {
+        "case": k,
+        "vehicle": vehicle,
+        "kind": kind,
+        "effects": [],
+        "params": {},
+        "hidden": {},
+        "n_bumps": 0,
+        "fidelity": {
+            "motor_tau_s": float(rng.uniform(0.002, 0.008)),
+            "truth_noise_mm": TRUTH_NOISE_MM,
+            "truth_noise_rad": TRUTH_NOISE_RAD,
+            "physics_dt_s": 0.001,
+        },
+    }
+    if kind in ("single", "pair"):
+        ch = catalog_choices(vehicle)
+        names = list(rng.choice(ch, size=1 if kind == "single" else 2, replace=False))
+        if kind == "pair" and "bumps" not in names and rng.uniform() < 0.5:
+            names[1] = "bumps"
+            if names[0] == "bumps":
+                names[0] = "ed"
+        for n in names:
+            p = draw_effect(rng, n, vehicle)
+            case["n_bumps"] = max(case["n_bumps"], p.pop("_n_bumps", 0))
+            case["params"].update(p)
+        case["effects"] = sorted(names)
+    elif kind == "ooc":
+        if rng.uniform() < 0.5:
+            case["effects"] = ["time_varying_diameter"]
+            case["hidden"] = {
+                "diam_var_amp": float(rng.choice([-1, 1]) * rng.uniform(0.005, 0.02)),
+                "diam_var_period_s": float(rng.uniform(20.0, 60.0)),
+            }
+        else:
+            case["effects"] = ["gear_backlash"]
+            case["hidden"] = {"backlash_rad": math.radians(float(rng.uniform(1.5, 5.0)))}
+    return case
+
+
+def scenario_json(case: dict) -> str:
+    eff: dict[str, dict] = {}
+    for k, v in case["params"].items():
+        e, p = k.split(".")
+        if e == "bumps":
+            eff.setdefault("bumps", {})["height_mm"] = v
+        else:
+            eff.setdefault(e, {})[p] = v
+    return json.dumps({"seed": 1, "effects": eff})
+
+
+def simulate_case(case: dict, real: Path, seed: int) -> dict:
+    """Write the recorded data of one case into `real`; returns the key's event list."""
+    so = lib()
+    robot_path = source_dir() / "host_sim" / "robots" / f"{case['vehicle']}.json"
+    robot = json.loads(robot_path.read_text())
+    robot["ipec"] = "off"
+    err = C.create_string_buffer(512)
+    s = so.odosim_setup_parse(json.dumps(robot).encode(), scenario_json(case).encode(), err, 512)
+    if not s:
+        raise RuntimeError(err.value.decode())
+    rng = np.random.default_rng(seed)
+    real.mkdir(parents=True)
+    (real / "robot.json").write_text(json.dumps(robot, indent=1))
+    rets, events_key = [], []
+    cap = 20000
+    rows = (RowEx * cap)()
+    evs = (Event * 512)()
+    try:
+        counters = {0: 0, 1: 0}
+        for exp, ccw, n in PLAN:
+            for _ in range(n):
+                d = "ccw" if ccw else "cw"
+                counters[ccw] += 1
+                k = counters[ccw]
+                bumps = case["n_bumps"] if "bumps" in case["effects"] else 0
+                o = Opts(
+                    exp.encode(),
+                    ccw,
+                    bumps,
+                    case["params"].get("bumps.height_mm", 10.0),
+                    0,
+                    so.odosim_run_seed(seed, ccw, k - 1),
+                    k - 1,
+                    0.001,
+                    case["fidelity"]["motor_tau_s"],
+                    case["hidden"].get("diam_var_amp", 0.0),
+                    case["hidden"].get("diam_var_period_s", 0.0),
+                    0.0,
+                    case["hidden"].get("backlash_rad", 0.0),
+                )
+                res = Result()
+                nev = C.c_size_t(0)
+                if (
+                    so.odosim_run_ex(
+                        s, C.byref(o), rows, cap, evs, 512, C.byref(nev), C.byref(res), err, 512
+                    )
+                    != 0
+                ):
+                    raise RuntimeError(err.value.decode())
+                a = np.ctypeslib.as_array(rows)[: res.n_ticks].copy()
+                name = f"run-{d}-{k:02d}"
+                _write_run(real / name, a, case, rng)
+                ex, ey = rng.normal(0, RETURN_NOISE_MM, 2)
+                rets.append(
+                    (
+                        k,
+                        d,
+                        res.x_abs_mm + ex,
+                        res.y_abs_mm + ey,
+                        res.theta_abs_deg + rng.normal(0, RETURN_NOISE_DEG),
+                        res.x_calc_mm,
+                        res.y_calc_mm,
+                        res.theta_calc_deg,
+                    )
+                )
+                for e in np.ctypeslib.as_array(evs)[: min(nev.value, 512)]:
+                    events_key.append(
+                        {
+                            "run": name,
+                            "truck": int(e["truck"]),
+                            "wheel": int(e["wheel"]),
+                            "x_mm": float(e["x_mm"]),
+                            "y_mm": float(e["y_mm"]),
+                            "t_s": float(e["t_s"]),
+                        }
+                    )
+    finally:
+        so.odosim_setup_free(s)
+    with (real / "returns.csv").open("w") as f:
+        f.write(
+            "run,direction,x_abs_mm,y_abs_mm,theta_abs_deg,x_calc_mm,y_calc_mm,theta_calc_deg\n"
+        )
+        for r in rets:
+            f.write("{},{},{:.3f},{:.3f},{:.4f},{:.3f},{:.3f},{:.4f}\n".format(*r))
+    return {"events": events_key}
+
+
+def _write_run(base: Path, a: np.ndarray, case: dict, rng: np.random.Generator) -> None:
+    t = a["t_us"] / 1e6
+    two = case["vehicle"] != "labmate"
+    frames = []
+    for tr, fid in ((0, 0x110), (1, 0x111))[: 2 if two else 1]:
+        pay = encode_payload(
+            fid,
+            {
+                "LeftCount": a["counts"][:, tr, 0],
+                "RightCount": a["counts"][:, tr, 1],
+                "Seq": a["wheel_seq"][:, tr],
+                "Status": a["wheel_status"][:, tr],
+            },
+        )
+        frames.append((t, fid, pay))
+    if two:
+        sel = a["rotary_present"] == 1
+        frames.append(
+            (
+                t[sel],
+                ID_ROTARY,
+                encode_payload(
+                    ID_ROTARY,
+                    {
+                        "Alpha": a["alpha_bam16"][sel] * (360.0 / 65536),
+                        "Beta": a["beta_bam16"][sel] * (360.0 / 65536),
+                        "Seq": a["rotary_seq"][sel],
+                        "Status": a["rotary_status"][sel],
+                    },
+                ),
+            )
+        )
+        sel = a["linear_present"] == 1
+        if sel.any():
+            frames.append(
+                (
+                    t[sel],
+                    ID_LINEAR,
+                    encode_payload(
+                        ID_LINEAR,
+                        {
+                            "Length": a["length_um"][sel] / 1000.0,
+                            "Seq": a["linear_seq"][sel],
+                            "Status": a["linear_status"][sel],
+                        },
+                    ),
+                )
+            )
+    write_candump(base.with_suffix(".log"), frames)
+    tr = a["truth"].copy()
+    n = tr.shape[0]
+    fid = case["fidelity"]
+    tr[:, :, :2] += rng.normal(0, fid["truth_noise_mm"], (n, 2, 2))
+    tr[:, :, 2] += rng.normal(0, fid["truth_noise_rad"], (n, 2))
+    lk = a["link_true"]
+    deg = 180.0 / math.pi
+    cols = np.column_stack(
+        [
+            a["t_s"],
+            tr[:, 0, 0],
+            tr[:, 0, 1],
+            tr[:, 0, 2] * deg,
+            tr[:, 1, 0],
+            tr[:, 1, 1],
+            tr[:, 1, 2] * deg,
+            lk[:, 0] * deg,
+            lk[:, 1] * deg,
+            lk[:, 2],
+        ]
+    )
+    with base.with_suffix(".truth.csv").open("w") as f:
+        f.write(
+            "t_s,a_x_mm,a_y_mm,a_theta_deg,b_x_mm,b_y_mm,b_theta_deg,alpha_deg,beta_deg,l_mm,events\n"
+        )
+        for r in cols:  # no events column content: a motion-capture system does not see bumps
+            f.write(
+                "{:.3f},{:.4f},{:.4f},{:.6f},{:.4f},{:.4f},{:.6f},{:.6f},{:.6f},{:.4f},\n".format(
+                    *tuple(r)
+                )
+            )
+
+
+# ------------------------------------------------------------------------------------------------
+# diagnosing side: worker processes that cannot open the keys
+# ------------------------------------------------------------------------------------------------
+def guard(forbidden: str) -> None:
+    """Install an audit hook refusing every open() of a path under `forbidden` (this process)."""
+    root = os.path.realpath(forbidden)
+
+    def hook(event: str, args: tuple) -> None:
+        if event == "open" and args and isinstance(args[0], (str, bytes, os.PathLike)):
+            p = os.fsdecode(args[0])
+            if os.path.realpath(p).startswith(root + os.sep) or os.path.realpath(p) == root:
+                raise PermissionError(f"odo-gap blind: the diagnosis may not open {p}")
+
+    sys.addaudithook(hook)
+
+
+def _diag(job: tuple) -> dict:
+    real, mode = job
+    from .diagnose import diagnose, write_report
+    from .errors import GapInputError
+
+    try:
+        rep = diagnose(real, Path(real) / "robot.json", 0.5, 1, mode)
+        write_report(dict(rep), Path(real).parent / f"report-{mode}")
+        rep.pop("_plot", None)
+        return {"real": real, "mode": mode, "report": rep}
+    except GapInputError as e:
+        return {"real": real, "mode": mode, "error": str(e)}
+
+
+def run_blind(n_cases: int, seed: int, out: str | Path, workers: int, progress=None) -> dict:
+    t0 = time.perf_counter()
+    out = Path(out)
+    tmp = out.with_name(out.name + f".tmp.{os.getpid()}")
+    shutil.rmtree(tmp, ignore_errors=True)
+    (tmp / "keys").mkdir(parents=True)
+    data = Path(tempfile.mkdtemp(prefix="odo-gap-blind-"))  # case data: nowhere near the keys
+    rng = np.random.default_rng(seed)
+    cases = [draw_case(rng, k) for k in range(n_cases)]
+    jobs = []
+    for c in cases:
+        real = data / f"case-{c['case']:03d}" / "real"
+        key = simulate_case(c, real, seed * 1000 + c["case"])
+        c.update(key)
+        (tmp / "keys" / f"case-{c['case']:03d}.json").write_text(json.dumps(c, indent=1))
+        for m in ("truth", "returns") + (("linkage",) if c["vehicle"] != "labmate" else ()):
+            jobs.append((str(real), m))
+        if progress:
+            progress(f"generated case {c['case'] + 1}/{n_cases}: {c['vehicle']}")
+    gen_s = time.perf_counter() - t0
+    ctx = mp.get_context("spawn")
+    results = []
+    with ctx.Pool(workers, initializer=guard, initargs=(str(tmp / "keys"),)) as pool:
+        for i, r in enumerate(pool.imap_unordered(_diag, jobs)):
+            results.append(r)
+            if progress and (i + 1) % 5 == 0:
+                progress(f"diagnosed {i + 1}/{len(jobs)}")
+    scores = score(cases, results)
+    scores["cases"] = n_cases
+    scores["seed"] = seed
+    scores["generate_s"] = gen_s
+    scores["total_s"] = time.perf_counter() - t0
+    (tmp / "scores.json").write_text(json.dumps(scores, indent=2) + "\n")
+    (tmp / "results.json").write_text(json.dumps([_summ(r) for r in results], indent=1) + "\n")
+    plot_scores(scores, tmp / "scores.png")
+    if out.exists():
+        shutil.rmtree(out)
+    tmp.rename(out)
+    shutil.rmtree(data, ignore_errors=True)
+    if progress:
+        progress(
+            json.dumps({k: v for k, v in scores.items() if k not in ("confusion", "per_case")})
+        )
+    return scores
+
+
+def _summ(r: dict) -> dict:
+    if "error" in r:
+        return r
+    rep = r["report"]
+    return {
+        "real": r["real"],
+        "mode": r["mode"],
+        "verdict": rep["verdict"]["effect"],
+        "best": rep["verdict"]["best_candidate"],
+        "params": rep["verdict"]["params"],
+        "shrink": rep["shrink"],
+        "elapsed_s": rep["elapsed_s"],
+        "explained_share": rep["verdict"]["evidence"]["explained_share"],
+        "dbic": rep["verdict"]["evidence"]["dbic_vs_nominal"],
+    }
+
+
+def norm(label: str) -> str:
+    """Verdicts name pairs in any order; compare them as sets."""
+    return "+".join(sorted(label.split("+")))
+
+
+def truth_label(c: dict) -> str:
+    if c["kind"] == "none":
+        return "no significant gap"
+    if c["kind"] == "ooc":
+        return "unexplained"
+    return "+".join(sorted(c["effects"]))
+
+
+def score(cases: list[dict], results: list[dict]) -> dict:
+    from .fit import UNIDENTIFIABLE
+
+    byreal = {}
+    for r in results:
+        byreal[(Path(r["real"]).parent.name, r["mode"])] = r
+    per_mode = {}
+    conf: dict[str, dict[str, int]] = {}
+    rel, loc, shr, times, per_case = [], [], [], [], []
+    for m in ("truth", "returns", "linkage"):
+        ok = tot = 0
+        for c in cases:
+            r = byreal.get((f"case-{c['case']:03d}", m))
+            if r is None or c["kind"] not in ("single", "pair"):
+                continue
+            if any(e in UNIDENTIFIABLE[m] for e in c["effects"]):
+                continue
+            if m == "linkage" and any(e in ("skid", "slip", "roughness") for e in c["effects"]):
+                continue
+            pred = norm(r["report"]["verdict"]["effect"]) if "report" in r else "error"
+            tot += 1
+            ok += pred == truth_label(c)
+        per_mode[m] = (ok / tot if tot else float("nan"), tot)
+    fa = [0, 0]
+    un = [0, 0]
+    for c in cases:
+        r = byreal.get((f"case-{c['case']:03d}", "truth"))
+        if r is None:
+            continue
+        pred = norm(r["report"]["verdict"]["effect"]) if "report" in r else "error"
+        lab = truth_label(c)
+        conf.setdefault(lab, {}).setdefault(pred, 0)
+        conf[lab][pred] += 1
+        per_case.append(
+            {
+                "case": c["case"],
+                "vehicle": c["vehicle"],
+                "truth": lab,
+                "pred": pred,
+                "params": c["params"],
+                "hidden": c["hidden"],
+            }
+        )
+        if "report" not in r:
+            continue
+        rep = r["report"]
+        times.append(rep["elapsed_s"])
+        if c["kind"] == "none":
+            fa[1] += 1
+            fa[0] += pred != "no significant gap"
+        if c["kind"] == "ooc":
+            un[1] += 1
+            un[0] += pred == "unexplained"
+        if c["kind"] in ("single", "pair") and pred == lab:
+            shr.append(rep["shrink"])
+            for e in c["effects"]:
+                k = PRIMARY[e]
+                tv = c["params"].get(k)
+                fv = rep["verdict"]["params"].get(k)
+                if tv is None or fv is None:
+                    continue
+                ref = abs(tv - NEUTRAL.get(k, 0.0))
+                rel.append(abs(fv - tv) / ref if ref > 0 else 0.0)
+            if "bumps" in c["effects"]:
+                keyev = c["events"]
+                for b in rep["verdict"]["bumps"]:
+                    cand = [
+                        e
+                        for e in keyev
+                        if e["wheel"] == b["wheel"]
+                        and e["truck"] == b["truck"]
+                        and e["run"] in b["runs"]
+                    ]
+                    if cand:
+                        loc.append(
+                            min(
+                                math.hypot(e["x_mm"] - b["x_mm"], e["y_mm"] - b["y_mm"])
+                                for e in cand
+                            )
+                        )
+    med = lambda x: float(np.median(x)) if x else float("nan")  # noqa: E731
+    return {
+        "top1_accuracy": per_mode["truth"][0],
+        "top1_cases": per_mode["truth"][1],
+        "top1_accuracy_return_errors": per_mode["returns"][0],
+        "top1_return_errors_cases": per_mode["returns"][1],
+        "top1_accuracy_linkage_only": per_mode["linkage"][0],
+        "top1_linkage_only_cases": per_mode["linkage"][1],
+        "false_alarm_rate": fa[0] / fa[1] if fa[1] else float("nan"),
+        "no_effect_cases": fa[1],
+        "unexplained_rate_out_of_catalog": un[0] / un[1] if un[1] else float("nan"),
+        "out_of_catalog_cases": un[1],
+        "param_rel_err_median": med(rel),
+        "bump_loc_err_mm_median": med(loc),
+        "shrink_median": med(shr),
+        "diagnose_10runs_s": med(times),
+        "diagnose_10runs_s_max": max(times) if times else float("nan"),
+        "confusion": conf,
+        "per_case": per_case,
+        "scoring": "top-1 over catalog cases (single and pair) whose effects the mode can "
+        "identify (fit.UNIDENTIFIABLE; linkage-only also skips floor effects slip, "
+        "skid, roughness); continuous-truth verdicts feed the other figures",
+    }
+
+
+def plot_scores(s: dict, path: Path) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    labs = sorted(s["confusion"])
+    preds = sorted({p for v in s["confusion"].values() for p in v})
+    M = np.array([[s["confusion"][t].get(p, 0) for p in preds] for t in labs])
+    fig, ax = plt.subplots(figsize=(1 + 0.6 * len(preds), 1 + 0.45 * len(labs)))
+    ax.imshow(M, cmap="Blues")
+    for i in range(len(labs)):
+        for j in range(len(preds)):
+            if M[i, j]:
+                ax.text(j, i, str(M[i, j]), ha="center", va="center", fontsize=7)
+    ax.set_xticks(range(len(preds)), preds, rotation=60, ha="right", fontsize=7)
+    ax.set_yticks(range(len(labs)), labs, fontsize=7)
+    ax.set_xlabel("verdict (continuous truth)")
+    ax.set_ylabel("withheld truth")
+    ax.set_title(
+        f"top-1 {s['top1_accuracy']:.0%}, false alarms {s['false_alarm_rate']:.0%}, "
+        f"OOC unexplained {s['unexplained_rate_out_of_catalog']:.0%}",
+        fontsize=8,
+    )
+    fig.tight_layout()
+    fig.savefig(path, dpi=90)
+    plt.close(fig)

@@ -1,0 +1,442 @@
+"""odo-gap diagnose: where the gap lies, which effect causes it, how far it shrinks (DESIGN s.6)"""
+
+from __future__ import annotations
+
+import itertools
+import json
+import math
+import os
+import shutil
+import time
+from pathlib import Path
+
+import numpy as np
+
+from .errors import GapInputError
+from .fit import (
+    ALWAYS_UNIDENTIFIABLE,
+    DBIC_PAIR,
+    DBIC_SIGNIFICANT,
+    EXPLAINED_MIN,
+    UNIDENTIFIABLE,
+    Fit,
+    Problem,
+    applicable,
+    clear_bumps,
+    cluster_bumps,
+    detect_bumps,
+    evaluate,
+    fit_params,
+    free_params,
+    place_bumps,
+)
+from .io import RunData, discover, read_robot
+from .model import prepare
+from .modes import MODES, TruthMode
+
+
+def pick_mode(runs: list[RunData], vehicle: str, want: str | None, real: Path) -> str:
+    have = {
+        "truth": all(r.truth is not None for r in runs),
+        "returns": all(r.ret is not None for r in runs),
+        "linkage": vehicle != "labmate" and all(r.log.alpha_deg is not None for r in runs),
+    }
+    if want:
+        if not have[want]:
+            missing = {
+                "truth": "a .truth.csv per run",
+                "returns": "returns.csv rows for every run",
+                "linkage": "LINK_ROTARY/LINK_LINEAR frames in every log (clapper/set)",
+            }[want]
+            raise GapInputError(real, f"mode {want} needs {missing}")
+        return want
+    for m in ("truth", "returns", "linkage"):
+        if have[m]:
+            return m
+    raise GapInputError(
+        real,
+        "no evidence to compare with: needs truth CSVs, returns.csv, or "
+        "linkage frames (clapper/set)",
+    )
+
+
+def split(runs: list[RunData], frac: float, seed: int) -> tuple[list[int], list[int]]:
+    """Held-out runs, stratified by direction (frac of each direction, at least one fit run)."""
+    rng = np.random.default_rng(seed)
+    fit, held = [], []
+    for d in sorted({r.direction for r in runs}):
+        idx = [i for i, r in enumerate(runs) if r.direction == d]
+        nh = min(len(idx) - 1, max(1, int(frac * len(idx)))) if frac > 0 else 0
+        perm = list(rng.permutation(idx))
+        held += sorted(perm[:nh])
+        fit += sorted(perm[nh:])
+    return sorted(fit), sorted(held)
+
+
+def explained(null: Fit, f: Fit) -> float:
+    excess = null.chi - null.n
+    if excess <= 0:
+        return 0.0
+    return float(np.clip((null.chi - f.chi) / excess, -1.0, 1.0))
+
+
+def fit_hypothesis(
+    name: str, prob: Problem, prs: list, vehicle: str, sig_head: float, base: Fit | None = None
+) -> Fit:
+    """A single effect or a pair 'a+b'."""
+    parts = name.split("+")
+    keys = [k for p in parts if p != "bumps" for k in free_params(p, vehicle)]
+    clear_bumps(prs)
+    if "bumps" not in parts:
+        P, se = fit_params(prob, keys)
+        return evaluate(prob, name, P, se, len(keys))
+    P0 = {}
+    if keys:
+        P0 = dict(base.params) if base is not None else fit_params(prob, keys)[0]
+    events = detect_bumps(prob.items, P0, sig_head)
+    fb = cluster_bumps(events)
+    place_bumps(prs, fb)
+    P, se = fit_params(prob, keys, {}) if keys else ({}, {})
+    h = float(np.median([b["h"] for b in fb])) if fb else 0.0
+    P = dict(P)
+    P["bumps.height_mm"] = h
+    se["bumps.height_mm"] = float(np.std([b["h"] for b in fb]) / math.sqrt(len(fb))) if fb else 0.0
+    f = evaluate(prob, name, P, se, len(keys) + 1 + 2 * len(fb), fb)
+    clear_bumps(prs)
+    return f
+
+
+def apply(f: Fit, prs: list) -> dict:
+    clear_bumps(prs)
+    if f.bumps:
+        place_bumps(prs, f.bumps)
+    return {k: v for k, v in f.params.items() if not k.startswith("bumps.")}
+
+
+def diagnose(
+    real: str | Path,
+    robot_path: str | Path,
+    holdout: float = 0.5,
+    seed: int = 1,
+    mode: str | None = None,
+    progress=None,
+) -> dict:
+    t0 = time.perf_counter()
+    robot = read_robot(robot_path)
+    real = Path(real)
+    runs = discover(real, robot)
+    if len(runs) < 2:
+        raise GapInputError(real, "needs at least two runs (one to fit, one to hold out)")
+    mode = pick_mode(runs, robot.vehicle, mode, real)
+    prs = [prepare(r, robot) for r in runs]
+    M = MODES[mode]
+    try:
+        items = [M(pr, robot) for pr in prs]
+    except ValueError as e:
+        raise GapInputError(real, f"mode {mode}: {e}") from None
+    fit_i, held_i = split(runs, holdout, seed)
+    if not held_i:
+        held_i = fit_i
+    prob = Problem(mode, [items[i] for i in fit_i])
+    chans = items[0].channels()
+    sig_head = float(prob.sigma[chans.index("A.heading_rad")]) if "A.heading_rad" in chans else 1e-3
+    fprs = [prs[i] for i in fit_i]
+    null = evaluate(prob, "nominal", {}, {}, 0)
+    singles = []
+    for h in applicable(mode, robot.vehicle):
+        if progress:
+            progress(f"fitting {h}")
+        singles.append(fit_hypothesis(h, prob, fprs, robot.vehicle, sig_head))
+    singles.sort(key=lambda f: f.bic)
+    best = singles[0]
+    cands = list(singles)
+    if null.bic - best.bic >= DBIC_SIGNIFICANT and explained(null, best) < EXPLAINED_MIN:
+        top = [f.name for f in singles[:4]]
+        for a, b in itertools.combinations(top, 2):
+            name = "+".join(sorted((a, b), key=lambda x: x == "bumps"))
+            if progress:
+                progress(f"fitting {name}")
+            basef = next((f for f in singles if f.name == name.split("+")[0]), None)
+            cands.append(fit_hypothesis(name, prob, fprs, robot.vehicle, sig_head, basef))
+    cands.sort(key=lambda f: f.bic)
+    best_single = singles[0]
+    best_pair = next((f for f in cands if "+" in f.name), None)
+    verdict_fit = best_single
+    if (
+        best_pair is not None
+        and best_single.bic - best_pair.bic >= DBIC_PAIR
+        and explained(null, best_pair) > explained(null, best_single)
+    ):
+        verdict_fit = best_pair
+    dbic = null.bic - verdict_fit.bic
+    share = explained(null, verdict_fit)
+    if dbic < DBIC_SIGNIFICANT:
+        verdict = "no significant gap"
+    elif share < EXPLAINED_MIN:
+        verdict = "unexplained"
+    else:
+        verdict = verdict_fit.name
+    runner = next((f for f in cands if f.name != verdict_fit.name), None)
+
+    # how far: held-out runs, before and after
+    hprs = [prs[i] for i in held_i]
+    P_after = apply(verdict_fit, hprs) if verdict not in ("no significant gap",) else {}
+    after = np.array([items[i].gap(P_after) for i in held_i])
+    clear_bumps(hprs)
+    before = np.array([items[i].gap({}) for i in held_i])
+    rng = np.random.default_rng(seed)
+    bs = []
+    for _ in range(1000):
+        s = rng.integers(0, len(held_i), len(held_i))
+        bs.append(before[s].sum() / max(after[s].sum(), 1e-9))
+    shrink = float(before.sum() / max(after.sum(), 1e-9))
+    ci = [float(np.percentile(bs, 2.5)), float(np.percentile(bs, 97.5))]
+
+    where = where_analysis(
+        items,
+        prs,
+        verdict_fit if verdict not in ("no significant gap",) else None,
+        chans,
+        prob.sigma,
+    )
+    unident = [{"what": k, "why": v} for k, v in UNIDENTIFIABLE[mode].items()]
+    unident += [{"what": k, "why": v} for k, v in ALWAYS_UNIDENTIFIABLE.items()]
+    for k, se in verdict_fit.stderr.items():
+        v = verdict_fit.params.get(k, 0.0)
+        lo, _hi = (0.8, 1.25) if k.endswith(".value") else (None, None)
+        ref = abs(v - 1.0) if lo is not None else abs(v)
+        if se and math.isfinite(se) and ref > 0 and se > 0.5 * ref:
+            unident.append(
+                {"what": k, "why": f"fitted {v:.4g} +- {se:.2g}: not fixed by these runs"}
+            )
+    if mode == "returns":
+        unident.append(
+            {
+                "what": "ed vs slip vs encoder bias",
+                "why": "return errors of one path excite them alike unless the paths differ",
+            }
+        )
+    report = {
+        "tool": "odo-gap diagnose",
+        "real": str(real),
+        "robot": str(robot_path),
+        "mode": mode,
+        "vehicle": robot.vehicle,
+        "runs": [r.name for r in runs],
+        "fit_runs": [runs[i].name for i in fit_i],
+        "heldout_runs": [runs[i].name for i in held_i],
+        "evidence_measure": "BIC = -2 ln L (Gaussian, per-channel sigma from the data) + k ln n",
+        "noise_sigma": dict(zip(chans, map(float, prob.sigma), strict=False)),
+        "thresholds": {
+            "dbic_significant": DBIC_SIGNIFICANT,
+            "explained_min": EXPLAINED_MIN,
+            "dbic_pair": DBIC_PAIR,
+        },
+        "verdict": {
+            "effect": verdict,
+            "best_candidate": verdict_fit.name,
+            "params": _clean(verdict_fit.params),
+            "stderr": _clean(verdict_fit.stderr),
+            "evidence": {
+                "bic": verdict_fit.bic,
+                "dbic_vs_nominal": dbic,
+                "explained_share": share,
+                "k": verdict_fit.k,
+                "n": verdict_fit.n,
+            },
+            "bumps": verdict_fit.bumps,
+        },
+        "runner_up": None
+        if runner is None
+        else {
+            "effect": runner.name,
+            "params": _clean(runner.params),
+            "bic": runner.bic,
+            "margin_dbic": runner.bic - verdict_fit.bic,
+        },
+        "ranking": [
+            {
+                "effect": f.name,
+                "bic": f.bic,
+                "dbic_vs_nominal": null.bic - f.bic,
+                "explained_share": explained(null, f),
+                "k": f.k,
+                "params": _clean(f.params),
+            }
+            for f in [*cands, null]
+        ],
+        "where": where,
+        "gap_metric": {
+            "truth": "RMS position error of truck A along the run (mm)",
+            "returns": "return position error (mm)",
+            "linkage": "RMS linkage prediction error over 1 s horizons (mm)",
+        }[mode],
+        "gap_before": float(before.mean()),
+        "gap_after_heldout": float(after.mean()),
+        "gap_before_runs": before.tolist(),
+        "gap_after_runs": after.tolist(),
+        "shrink": shrink,
+        "shrink_ci": ci,
+        "unidentifiable": unident,
+        "elapsed_s": time.perf_counter() - t0,
+    }
+    report["_plot"] = {"items": items, "prs": prs, "fit": verdict_fit, "cands": cands, "null": null}
+    return report
+
+
+def _clean(d: dict) -> dict:
+    return {k: float(v) for k, v in d.items()}
+
+
+def classify(pr, tick_s: float) -> np.ndarray:
+    """Per tick: stationary, turn (on the spot), straight, arc, accelerating."""
+    ds = pr.ds[:, 0, :]
+    v = 0.5 * (ds[:, 0] + ds[:, 1]) / pr.dt
+    om = (ds[:, 1] - ds[:, 0]) / pr.b[0] / pr.dt
+    acc = np.abs(np.gradient(v, pr.t[1:]))
+    lab = np.full(v.size, "straight", dtype=object)
+    lab[np.abs(om) * 0.5 * pr.b[0] > 0.2 * np.maximum(np.abs(v), 1e-9)] = "arc"
+    lab[(np.abs(v) < 5.0) & (np.abs(om) > 0.02)] = "turn"
+    lab[(acc > 50.0) & (lab == "straight")] = "acceleration"
+    lab[(np.abs(v) < 1.0) & (np.abs(om) < 0.005)] = "stationary"
+    return lab
+
+
+def where_analysis(items, prs, f: Fit | None, chans, sigma) -> list[dict]:
+    out = []
+    for it, pr in zip(items, prs, strict=False):
+        r = it.residuals({})
+        entry = {"run": pr.run.name, "gap": it.gap({})}
+        w = r / sigma
+        share = (w**2).sum(axis=0)
+        tot = share.sum() or 1.0
+        entry["channels"] = {c: float(s / tot) for c, s in zip(chans, share, strict=False)}
+        if isinstance(it, TruthMode):
+            lab = classify(pr, pr.dt.mean())
+            tmid = pr.t[1:]
+            wl = lab[np.clip(np.searchsorted(tmid, it.tt[it.i]), 0, lab.size - 1)]
+            segs = {}
+            for s in np.unique(wl):
+                segs[str(s)] = float((w[wl == s] ** 2).sum() / tot)
+            entry["segments"] = segs
+            # legs: motion between stops
+            moving = lab != "stationary"
+            edges = np.flatnonzero(np.diff(moving.astype(int)))
+            entry["n_legs"] = int((edges.size + 1) // 2)
+            tt, err = it.error_track({})
+            dist = np.interp(tt, pr.t, pr.S[:, 0].mean(axis=1))
+            e = np.hypot(err[:, 0], err[:, 1])
+            entry["gap_end_mm"] = float(e[-1])
+            entry["gap_max_mm"] = float(e.max())
+            entry["gap_max_at_mm"] = float(dist[int(np.argmax(e))])
+        if f is not None and f.bumps:
+            from .fit import group_key
+
+            g = group_key(pr)
+            entry["events"] = [
+                {
+                    "kind": "bump",
+                    "truck": "AB"[b["truck"]],
+                    "wheel": ("left", "right")[b["wheel"]],
+                    "at_wheel_travel_mm": b["s0"],
+                    "height_mm": b["h"],
+                    "x_mm": b["x_mm"],
+                    "y_mm": b["y_mm"],
+                }
+                for b in f.bumps
+                if b["group"] == g
+            ]
+        out.append(entry)
+    return out
+
+
+def write_report(rep: dict, out: str | Path) -> None:
+    """Everything into OUT.tmp.<pid>, then renamed into place: never a partial report."""
+    from .plots import plot_report
+
+    out = Path(out)
+    tmp = out.with_name(out.name + f".tmp.{os.getpid()}")
+    if tmp.exists():
+        shutil.rmtree(tmp)
+    tmp.mkdir(parents=True)
+    try:
+        extra = rep.pop("_plot", None)
+        (tmp / "report.json").write_text(json.dumps(rep, indent=2) + "\n")
+        (tmp / "report.md").write_text(markdown(rep))
+        if extra is not None:
+            plot_report(rep, extra, tmp)
+        if out.exists():
+            old = out.with_name(out.name + f".old.{os.getpid()}")
+            out.rename(old)
+            tmp.rename(out)
+            shutil.rmtree(old)
+        else:
+            tmp.rename(out)
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+
+
+def markdown(rep: dict) -> str:
+    v = rep["verdict"]
+    L = [
+        f"# odo-gap diagnosis: {rep['real']}",
+        "",
+        f"Mode **{rep['mode']}** ({rep['vehicle']}), {len(rep['runs'])} runs: fitted on "
+        f"{len(rep['fit_runs'])}, judged on {len(rep['heldout_runs'])} held out.",
+        "",
+        f"## Verdict: **{v['effect']}**",
+        "",
+    ]
+    if v["effect"] != v["best_candidate"]:
+        L.append(
+            f"Best candidate {v['best_candidate']} explains {v['evidence']['explained_share']:.0%} "
+            f"of the excess misfit (needs {rep['thresholds']['explained_min']:.0%})."
+        )
+    L += ["| parameter | fitted | +- |", "|---|---|---|"]
+    for k, x in v["params"].items():
+        L.append(f"| {k} | {x:.6g} | {v['stderr'].get(k, float('nan')):.2g} |")
+    e = v["evidence"]
+    L += [
+        "",
+        f"Evidence ({rep['evidence_measure']}): Delta BIC vs nominal {e['dbic_vs_nominal']:.1f}, "
+        f"explained share {e['explained_share']:.3f}, k = {e['k']}, n = {e['n']}.",
+    ]
+    if rep["runner_up"]:
+        r = rep["runner_up"]
+        L.append(f"Runner-up: {r['effect']} (BIC margin {r['margin_dbic']:.1f}).")
+    L += [
+        "",
+        "## How far it shrinks (held-out runs)",
+        "",
+        f"Gap metric: {rep['gap_metric']}. Before {rep['gap_before']:.2f}, after "
+        f"{rep['gap_after_heldout']:.2f}: shrink x{rep['shrink']:.1f} "
+        f"(95% CI {rep['shrink_ci'][0]:.1f} - {rep['shrink_ci'][1]:.1f}).",
+        "",
+        "## Ranking",
+        "",
+        "| hypothesis | Delta BIC vs nominal | explained | k |",
+        "|---|---|---|---|",
+    ]
+    for r in rep["ranking"][:12]:
+        L.append(
+            f"| {r['effect']} | {r['dbic_vs_nominal']:.1f} | {r['explained_share']:.3f} "
+            f"| {r['k']} |"
+        )
+    L += ["", "## Where", ""]
+    for w in rep["where"]:
+        ch = max(w["channels"], key=w["channels"].get)
+        s = f"- {w['run']}: gap {w['gap']:.2f}; mostly in {ch} ({w['channels'][ch]:.0%})"
+        if "segments" in w:
+            sg = max(w["segments"], key=w["segments"].get)
+            s += f", during {sg} ({w['segments'][sg]:.0%}); end error {w['gap_end_mm']:.1f} mm"
+        if w.get("events"):
+            s += f"; {len(w['events'])} bump(s): " + ", ".join(
+                f"{x['wheel']} at {x['at_wheel_travel_mm']:.0f} mm "
+                f"({x['x_mm']:.0f}, {x['y_mm']:.0f})"
+                for x in w["events"][:5]
+            )
+        L.append(s)
+    L += ["", "## Not identifiable from these data", ""]
+    L += [f"- {u['what']}: {u['why']}" for u in rep["unidentifiable"]]
+    return "\n".join(L) + "\n"

@@ -1,0 +1,373 @@
+"""Hypotheses, fits and evidence.
+
+Evidence is BIC: deviance -2 ln L of Gaussian residuals (per-channel noise sigma estimated once
+from the data: stationary windows, else the high-pass residual; roughness adds its own variance)
+plus k ln n for k fitted parameters over n residual scalars. Lower is better; Delta BIC > 10 is
+"very strong" (Kass & Raftery 1995) and is the threshold used throughout.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.optimize import least_squares
+
+from .model import Prepared, bump_excess
+from .simlib import catalog
+
+DBIC_SIGNIFICANT = 10.0  # best hypothesis vs nominal: below -> "no significant gap"
+EXPLAINED_MIN = 0.75  # share of the excess misfit a verdict must remove, else "unexplained"
+DBIC_PAIR = 10.0  # a pair must beat the best single by this much
+
+# Free parameters per hypothesis (others stay at the catalog default). See README for why.
+FREE = {
+    "ed": ["value"],
+    "eb": ["value"],
+    "es": ["value"],
+    "roughness": ["max_height_mm"],
+    "slip": ["k_per_m_s2"],
+    "skid": ["k_s"],
+    "rotary_bias": ["alpha_deg", "beta_deg"],
+    "link_bias": ["const_mm", "ecc_mm"],
+}
+START = {"slip.k_per_m_s2": 0.05, "skid.k_s": 0.05, "roughness.max_height_mm": 0.5}
+UNIDENTIFIABLE = {
+    "returns": {
+        "es": "closed paths do not fix the overall scale (Es)",
+        "bumps": "return errors carry no positions of discrete events",
+        "rotary_bias": "needs linkage readings",
+        "link_bias": "needs linkage readings",
+    },
+    "truth": {},
+    "linkage": {"bumps": "not located from linkage readings alone (tested in truth mode)"},
+}
+ALWAYS_UNIDENTIFIABLE = {
+    "tire_compression": "kinematically an Ed plus an Es (off-centre load and mean load): aliased "
+    "with the pair ed+es, reported through them",
+    "count_loss": "lost counts leave no trace in the counts themselves at these speeds",
+}
+
+
+def applicable(mode: str, vehicle: str) -> list[str]:
+    h = ["ed", "eb", "es", "roughness", "slip", "skid"]
+    if mode == "truth":
+        h.append("bumps")
+    if vehicle != "labmate" and mode in ("truth", "linkage"):
+        h.append("rotary_bias")
+        if vehicle == "clapper":
+            h.append("link_bias")
+    return [x for x in h if x not in UNIDENTIFIABLE[mode]]
+
+
+def free_params(effect: str, vehicle: str) -> list[str]:
+    f = FREE.get(effect, [])
+    if effect == "rotary_bias" and vehicle == "set":
+        f = ["alpha_deg"]
+    return [f"{effect}.{p}" for p in f]
+
+
+def bounds(key: str) -> tuple[float, float, float]:
+    e, p = key.split(".")
+    d = next(x for x in catalog()[e]["params"] if x["name"] == p)
+    return float(d["min"]), float(d["max"]), float(d["default"])
+
+
+@dataclass
+class Problem:
+    """The fitting runs of one mode: residual builders, noise, data count."""
+
+    mode: str
+    items: list  # mode objects (one per run)
+    sigma: np.ndarray = field(default=None)
+
+    def __post_init__(self) -> None:
+        if self.sigma is None:
+            self.sigma = estimate_sigma(self.items, self.mode)
+
+    def resid(self, P: dict) -> np.ndarray:
+        return np.vstack([it.residuals(P) for it in self.items])
+
+    def deviance(self, P: dict) -> tuple[float, float, int]:
+        """(-2 ln L relative to sigma, weighted chi^2, n scalars)."""
+        r = self.resid(P)
+        v = np.broadcast_to(self.sigma**2, r.shape)
+        ev = [it.extra_var(P) for it in self.items]
+        if any(e is not None for e in ev):
+            v = v + np.vstack(
+                [
+                    e if e is not None else np.zeros((it.residuals(P).shape[0], r.shape[1]))
+                    for e, it in zip(ev, self.items, strict=False)
+                ]
+            )
+        chi = float(np.sum(r * r / v))
+        dev = chi + float(np.sum(np.log(v / self.sigma**2)))
+        return dev, chi, r.size
+
+    def wresid(self, P: dict) -> np.ndarray:
+        return (self.resid(P) / self.sigma).ravel()
+
+
+def estimate_sigma(items: list, mode: str) -> np.ndarray:
+    """Per-channel noise of the nominal model's residuals (see module doc)."""
+    r = np.vstack([it.residuals({}) for it in items])
+    floor = np.array([2e-5 if ch.endswith("_rad") else 0.02 for ch in items[0].channels()])
+    if mode == "returns":
+        # no repeated-measurement floor exists: the spread of the runs around their direction's
+        # mean is the non-systematic part (000 s. 3.3); a floor keeps it from vanishing
+        dirs = np.array([it.pr.run.direction for it in items])
+        dev = np.vstack([r[dirs == d] - r[dirs == d].mean(axis=0) for d in np.unique(dirs)])
+        s = np.sqrt(np.sum(dev**2, axis=0) / max(1, r.shape[0] - np.unique(dirs).size))
+        return np.maximum(s, np.array([0.5, 0.5, 1e-4]))
+    if mode == "truth":
+        for c, ch in enumerate(items[0].channels()):
+            if ch in ("alpha_rad", "beta_rad"):  # encoder quantisation (10 bit: 0.1 deg)
+                floor[c] = items[0].q_rad
+            elif ch == "l_mm":
+                floor[c] = items[0].q_l_mm
+        st = np.concatenate([it.stationary() for it in items])
+        if st.sum() >= 8:
+            s = 1.4826 * np.median(np.abs(r[st]), axis=0)
+            return np.maximum(s, floor)
+    d = np.diff(r, axis=0)
+    s = 1.4826 * np.median(np.abs(d - np.median(d, axis=0)), axis=0) / math.sqrt(2)
+    if mode == "linkage":
+        q = items[0].q_rad
+        floor = np.array(
+            [q, q if items[0].clapper else 0.05, 0.05 / math.sqrt(12) if items[0].clapper else 0.05]
+        )
+    return np.maximum(s, floor)
+
+
+@dataclass
+class Fit:
+    name: str  # "ed", "ed+bumps", "nominal"
+    params: dict
+    stderr: dict
+    dev: float
+    chi: float
+    n: int
+    k: int
+    bumps: list = field(default_factory=list)
+
+    @property
+    def bic(self) -> float:
+        return self.dev + self.k * math.log(max(self.n, 2))
+
+
+def fit_params(prob: Problem, keys: list[str], base: dict | None = None) -> tuple[dict, dict]:
+    base = dict(base or {})
+    if not keys:
+        return base, {}
+    lo, hi, x0 = zip(*(bounds(k) for k in keys), strict=False)
+    x0 = [START.get(k, d) for k, d in zip(keys, x0, strict=False)]
+
+    def f(x):
+        P = dict(base)
+        P.update(zip(keys, x, strict=False))
+        return prob.wresid(P)
+
+    best = None
+    starts = [x0]
+    if any(k.startswith(("slip", "skid")) for k in keys):
+        starts.append(
+            [
+                min(h, 0.5) if k.startswith(("slip", "skid")) else s
+                for k, s, h in zip(keys, x0, hi, strict=True)
+            ]
+        )
+    for s0 in starts:
+        s0 = np.clip(s0, np.array(lo) + 1e-12, np.array(hi) - 1e-12)
+        res = least_squares(f, s0, bounds=(lo, hi), x_scale="jac", max_nfev=60)
+        if best is None or res.cost < best.cost:
+            best = res
+    P = dict(base)
+    P.update(zip(keys, best.x, strict=False))
+    se = {}
+    try:
+        J = best.jac
+        cov = np.linalg.pinv(J.T @ J)
+        for i, k in enumerate(keys):
+            se[k] = float(math.sqrt(max(cov[i, i], 0.0)))
+    except (np.linalg.LinAlgError, ValueError):
+        se = {k: float("nan") for k in keys}
+    return P, se
+
+
+def evaluate(prob: Problem, name: str, P: dict, se: dict, k: int, bumps=None) -> Fit:
+    dev, chi, n = prob.deviance(P)
+    return Fit(name, P, se, dev, chi, n, k, bumps or [])
+
+
+# ------------------------------------------------------------------------------------------------
+# discrete bumps (truth mode): locate heading steps, fit each with the exact profile, cluster
+# the events of runs of the same path into floor bumps
+# ------------------------------------------------------------------------------------------------
+def _signed_excess(
+    pr: Prepared, truck: int, wheel: int, h: float, s0: float, a: int = 0, b: int | None = None
+) -> np.ndarray:
+    """Heading (rad) a bump under (truck, wheel) adds at ticks a..b (up to a constant)."""
+    b = pr.S.shape[0] if b is None else b
+    e = bump_excess(pr.R[truck], h, pr.S[a:b, truck, wheel] - s0)
+    sg = np.sign(pr.ds[a : b - 1, truck, wheel])
+    d = np.concatenate([[0.0], np.cumsum(sg * np.diff(e))])
+    return (d if wheel == 0 else -d) / pr.b[truck]
+
+
+def detect_bumps(items: list, P: dict, sigma_head: float) -> list[dict]:
+    """Heading steps in each run's truth-minus-model heading; each refined to (wheel, s0, h)."""
+    events = []
+    for it in items:
+        pr = it.pr
+        for truck in range(it.trucks):
+            mp = it.model_pose(P, truck)
+            e = it.tpose[:, truck, 2] - mp[:, 2]
+            tt = it.tt
+            dt = float(np.median(np.diff(tt)))
+            m = max(3, round(0.5 / dt))
+            c = np.concatenate([[0.0], np.cumsum(e)])
+            k = np.arange(2 * m, e.size - 2 * m)
+
+            def mean(a, b, c=c, m=m):
+                return (c[b] - c[a]) / m
+
+            # step minus a third of the outer difference: zero for a ramp (drift), 2/3 of a step
+            D = (mean(k, k + m) - mean(k - m, k)) - (
+                mean(k + m, k + 2 * m) - mean(k - 2 * m, k - m)
+            ) / 3
+            D *= 1.5
+            if D.size == 0:
+                continue
+            sd = 1.4826 * np.median(np.abs(D - np.median(D)))
+            thr = max(8.0 * sd, 6.0 * sigma_head / math.sqrt(m), 2e-4)
+            absd = np.abs(D).copy()
+            Sa = np.stack([np.interp(tt, pr.t, pr.S[:, truck, w]) for w in (0, 1)])
+            for _ in range(20):
+                q = int(np.argmax(absd))
+                if absd[q] < thr:
+                    break
+                absd[max(0, q - 2 * m) : q + 2 * m] = 0.0
+                kc = int(k[q])
+                lo, hi = max(0, kc - 2 * m), min(e.size - 1, kc + 2 * m)
+                best = None
+                for w in (0, 1):
+                    s_lo, s_hi = Sa[w, lo], Sa[w, hi]
+                    if s_hi - s_lo < 20.0:
+                        continue
+                    idx = np.arange(lo, hi + 1)
+                    tick_idx = np.searchsorted(pr.t, tt[idx] - 1e-9)
+                    tick_idx = np.clip(tick_idx, 0, pr.t.size - 1)
+                    ta, tb = int(tick_idx[0]), int(tick_idx[-1]) + 1
+                    ti_loc = tick_idx - ta
+
+                    def res(
+                        x,
+                        w=w,
+                        idx=idx,
+                        ti=ti_loc,
+                        pr=pr,
+                        truck=truck,
+                        e=e,
+                        tt=tt,
+                        kc=kc,
+                        ta=ta,
+                        tb=tb,
+                    ):
+                        h, s0, c0, c1 = x
+                        prof = _signed_excess(pr, truck, w, h, s0, ta, tb)[ti]
+                        return (e[idx] - c0 - c1 * (tt[idx] - tt[kc]) - prof) / 1e-4
+
+                    s_mid = Sa[w, kc]
+                    for hs in (3.0, 12.0):
+                        try:
+                            r = least_squares(
+                                res,
+                                [hs, s_mid - 30.0, e[lo], 0.0],
+                                bounds=(
+                                    [0.2, s_lo - 100, -np.inf, -np.inf],
+                                    [50.0, s_hi, np.inf, np.inf],
+                                ),
+                                max_nfev=80,
+                            )
+                        except ValueError:
+                            continue
+                        if best is None or r.cost < best[0]:
+                            best = (r.cost, w, r.x)
+                if best is None:
+                    continue
+                _, w, x = best
+                j = int(np.clip(np.searchsorted(Sa[w], x[1]), 0, tt.size - 1))
+                th = it.tpose[j, truck, 2]
+                half = (0.5 if w == 0 else -0.5) * pr.b[truck]
+                xy = (
+                    it.tpose[j, truck, 0] - half * math.sin(th),
+                    it.tpose[j, truck, 1] + half * math.cos(th),
+                )
+                events.append(
+                    {
+                        "run": pr.run.name,
+                        "group": group_key(pr),
+                        "truck": truck,
+                        "wheel": w,
+                        "s0": float(x[1]),
+                        "h": float(x[0]),
+                        "t_s": float(tt[j]),
+                        "x_mm": float(xy[0]),
+                        "y_mm": float(xy[1]),
+                    }
+                )
+    return events
+
+
+def group_key(pr: Prepared) -> str:
+    return f"{pr.run.direction}:{round(pr.S[-1, 0].mean() / 2000.0)}"
+
+
+def cluster_bumps(events: list[dict], tol_mm: float = 80.0) -> list[dict]:
+    """Events of runs on the same path at the same wheel travel are one floor bump."""
+    out = []
+    keyf = lambda e: (e["group"], e["truck"], e["wheel"])  # noqa: E731
+    for key in sorted({keyf(e) for e in events}):
+        evs = sorted((e for e in events if keyf(e) == key), key=lambda e: e["s0"])
+        cur: list[dict] = []
+        for e in [*evs, None]:
+            if e is not None and (not cur or e["s0"] - cur[-1]["s0"] < tol_mm):
+                cur.append(e)
+                continue
+            if cur:
+                out.append(
+                    {
+                        "group": key[0],
+                        "truck": key[1],
+                        "wheel": key[2],
+                        "s0": float(np.median([c["s0"] for c in cur])),
+                        "h": float(np.median([c["h"] for c in cur])),
+                        "x_mm": float(np.median([c["x_mm"] for c in cur])),
+                        "y_mm": float(np.median([c["y_mm"] for c in cur])),
+                        "t_s": float(np.median([c["t_s"] for c in cur])),
+                        "runs": sorted({c["run"] for c in cur}),
+                    }
+                )
+            cur = [e] if e is not None else []
+    return out
+
+
+def place_bumps(prs: list[Prepared], floor_bumps: list[dict], h: float | None = None) -> None:
+    for pr in prs:
+        g = group_key(pr)
+        pr.bumps = [
+            {
+                "truck": b["truck"],
+                "wheel": b["wheel"],
+                "s0": b["s0"],
+                "h": h if h is not None else b["h"],
+            }
+            for b in floor_bumps
+            if b["group"] == g
+        ]
+
+
+def clear_bumps(prs: list[Prepared]) -> None:
+    for pr in prs:
+        pr.bumps = []

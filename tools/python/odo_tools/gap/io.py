@@ -1,0 +1,451 @@
+"""Recorded data in: candump logs (decoded with the repo's DBC), truth CSVs, returns.csv, robot.
+
+Every reader validates what it reads and raises GapInputError naming the file and line; nothing
+here reads a scenario file (the diagnosis must not know the truth's effects).
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+import os
+import re
+from dataclasses import dataclass, field
+from functools import lru_cache
+from pathlib import Path
+
+import numpy as np
+
+from .errors import GapInputError
+
+ID_WHEEL = {0x110: 0, 0x111: 1}
+ID_ROTARY = 0x120
+ID_LINEAR = 0x121
+LINE_RE = re.compile(r"^\((\d+\.\d+)\)\s+(\S+)\s+([0-9A-Fa-f]{3,8})#([0-9A-Fa-f]*)$")
+RUN_RE = re.compile(r"^run-(?P<dir>[a-z]+)-(?P<idx>\d+)\.log$")
+
+
+def source_dir() -> Path:
+    """The repository root (ODO_SOURCE_DIR, else found from this file)."""
+    env = os.environ.get("ODO_SOURCE_DIR")
+    if env:
+        return Path(env)
+    here = Path(__file__).resolve()
+    for p in here.parents:
+        if (p / "can" / "odometry.dbc").is_file():
+            return p
+    raise GapInputError(here, "cannot find the repository (can/odometry.dbc); set ODO_SOURCE_DIR")
+
+
+@dataclass(frozen=True)
+class SignalLayout:
+    start: int
+    length: int
+    signed: bool
+    scale: float
+    offset: float
+
+
+@lru_cache(maxsize=1)
+def dbc_layouts() -> dict[int, dict[str, SignalLayout]]:
+    """Signal layouts of the sensor frames from can/odometry.dbc via cantools (the one contract)."""
+    import cantools
+
+    db = cantools.database.load_file(str(source_dir() / "can" / "odometry.dbc"))
+    out: dict[int, dict[str, SignalLayout]] = {}
+    for fid in (*ID_WHEEL, ID_ROTARY, ID_LINEAR):
+        msg = db.get_message_by_frame_id(fid)
+        lay = {}
+        for s in msg.signals:
+            if s.byte_order != "little_endian":
+                raise GapInputError(
+                    "can/odometry.dbc", f"{msg.name}.{s.name}: expected little endian"
+                )
+            lay[s.name] = SignalLayout(
+                s.start, s.length, s.is_signed, float(s.scale), float(s.offset)
+            )
+        out[fid] = lay
+    return out
+
+
+def decode_signal(payload: np.ndarray, s: SignalLayout) -> np.ndarray:
+    """Vectorised little-endian extraction of one signal from uint64 payloads."""
+    raw = (payload >> np.uint64(s.start)) & np.uint64((1 << s.length) - 1)
+    v = raw.astype(np.int64)
+    if s.signed:
+        v = np.where(v >= (1 << (s.length - 1)), v - (1 << s.length), v)
+    return v * s.scale + s.offset if (s.scale != 1.0 or s.offset != 0.0) else v
+
+
+@dataclass
+class Robot:
+    path: str
+    vehicle: str
+    tick_s: float
+    trucks: list[dict]
+    linkage: dict = field(default_factory=dict)
+    trailer: dict = field(default_factory=dict)
+    raw: dict = field(default_factory=dict)
+
+    def mm_per_count(self, t: int) -> float:
+        d = self.trucks[t]
+        return math.pi * d["wheel_diameter_mm"] / (4.0 * d["encoder_lines"] * d["gear_ratio"])
+
+    @property
+    def n_trucks(self) -> int:
+        return len(self.trucks)
+
+
+def _num(obj: dict, key: str, where: str, path: Path, lo: float, hi: float) -> float:
+    v = obj.get(key)
+    if not isinstance(v, (int, float)) or isinstance(v, bool) or not (lo <= v <= hi):
+        raise GapInputError(path, f"{where}{key}: expected a number in [{lo}, {hi}], got {v!r}")
+    return float(v)
+
+
+def read_robot(path: str | Path) -> Robot:
+    """A robot description (host_sim/robots/*.json schema): what the firmware believes."""
+    path = Path(path)
+    try:
+        text = path.read_text()
+    except OSError as e:
+        raise GapInputError(path, f"cannot read robot description: {e.strerror}") from None
+    try:
+        raw = json.loads(text)
+    except json.JSONDecodeError as e:
+        raise GapInputError(path, f"malformed JSON: {e.msg} (column {e.colno})", e.lineno) from None
+    if not isinstance(raw, dict) or raw.get("vehicle") not in ("labmate", "clapper", "set"):
+        raise GapInputError(path, "vehicle: expected labmate, clapper or set")
+    trucks_raw = raw.get("trucks")
+    names = ["A"] if raw["vehicle"] == "labmate" else ["A", "B"]
+    if not isinstance(trucks_raw, dict) or any(n not in trucks_raw for n in names):
+        raise GapInputError(path, f"trucks: expected {' and '.join(names)}")
+    trucks = []
+    for n in names:
+        t = trucks_raw[n]
+        w = f"trucks.{n}."
+        trucks.append(
+            {
+                "wheel_diameter_mm": _num(t, "wheel_diameter_mm", w, path, 1.0, 5000.0),
+                "wheelbase_mm": _num(t, "wheelbase_mm", w, path, 1.0, 10000.0),
+                "encoder_lines": _num(t, "encoder_lines", w, path, 1.0, 1e7),
+                "gear_ratio": _num(t, "gear_ratio", w, path, 1e-3, 1e4),
+                "counter_bits": int(_num(t, "counter_bits", w, path, 8, 32)),
+                "invert_left": bool(t.get("invert_left", False)),
+                "invert_right": bool(t.get("invert_right", False)),
+            }
+        )
+    tick_ms = _num(raw, "tick_ms", "", path, 1.0, 1000.0) if "tick_ms" in raw else 40.0
+    r = Robot(str(path), raw["vehicle"], tick_ms / 1000.0, trucks, raw=raw)
+    if r.vehicle == "clapper":
+        lk = raw.get("linkage")
+        if not isinstance(lk, dict):
+            raise GapInputError(path, "linkage: required for a clapper")
+        r.linkage = {
+            "length_mm": _num(lk, "length_mm", "linkage.", path, 1.0, 1e5),
+            "rotary_bits": int(lk.get("rotary_bits", 10)),
+            "linear_resolution_mm": float(lk.get("linear_resolution_mm", 0.1)),
+        }
+    if r.vehicle == "set":
+        tr = raw.get("trailer")
+        if not isinstance(tr, dict):
+            raise GapInputError(path, "trailer: required for a set")
+        r.trailer = {
+            "hitch_offset_mm": _num(tr, "hitch_offset_mm", "trailer.", path, 0.0, 1e5),
+            "trailer_length_mm": _num(tr, "trailer_length_mm", "trailer.", path, 1.0, 1e5),
+            "rotary_bits": int(tr.get("rotary_bits", 10)),
+        }
+    return r
+
+
+@dataclass
+class SensorLog:
+    """One run's sensor frames, one row per firmware tick (the WHEEL_COUNTS_A frames)."""
+
+    path: str
+    t_s: np.ndarray  # (n,)
+    counts: np.ndarray  # (n, trucks, 2) raw counter values, [left, right]
+    alpha_deg: np.ndarray | None = None  # (n,) linkage rotary A (clapper) / joint (set)
+    beta_deg: np.ndarray | None = None
+    l_mm: np.ndarray | None = None
+
+
+def read_log(path: str | Path, robot: Robot) -> SensorLog:
+    """Decode a candump -l log of sensor frames with the DBC; checks it against the robot."""
+    path = Path(path)
+    try:
+        lines = path.read_text().splitlines()
+    except (OSError, UnicodeDecodeError) as e:
+        raise GapInputError(path, f"cannot read log: {getattr(e, 'strerror', None) or e}") from None
+    if not lines:
+        raise GapInputError(path, "empty log: no sensor frames")
+    ts = np.empty(len(lines))
+    ids = np.empty(len(lines), dtype=np.int64)
+    pay = np.zeros(len(lines), dtype=np.uint64)
+    for i, ln in enumerate(lines):
+        m = LINE_RE.match(ln.strip())
+        if m is None:
+            raise GapInputError(path, f"not a candump -l line: {ln[:60]!r}", i + 1)
+        data = m.group(4)
+        if len(data) % 2 or len(data) > 16:
+            raise GapInputError(path, f"bad payload {data!r}", i + 1)
+        ts[i] = float(m.group(1))
+        ids[i] = int(m.group(3), 16)
+        pay[i] = int.from_bytes(bytes.fromhex(data).ljust(8, b"\0"), "little")
+    bad = np.nonzero(np.diff(ts) < 0)[0]
+    if bad.size:
+        raise GapInputError(path, "time goes backwards", int(bad[0]) + 2)
+    lay = dbc_layouts()
+    sel_a = ids == 0x110
+    if not sel_a.any():
+        raise GapInputError(
+            path, "no WHEEL_COUNTS_A (0x110) frames: the wheel counts every mode needs"
+        )
+    t = ts[sel_a]
+    dt = np.diff(t)
+    if dt.size and (dt <= 0).any():
+        raise GapInputError(
+            path,
+            "two WHEEL_COUNTS_A frames with the same time",
+            int(np.nonzero(sel_a)[0][np.nonzero(dt <= 0)[0][0] + 1]) + 1,
+        )
+    if dt.size:
+        med = float(np.median(dt))
+        if abs(med - robot.tick_s) > 0.1 * robot.tick_s:
+            raise GapInputError(
+                path,
+                f"frames every {med * 1e3:.1f} ms but {robot.path} says "
+                f"tick_ms {robot.tick_s * 1e3:g}",
+                1,
+            )
+        gap = np.nonzero(dt > 3.5 * med)[0]
+        if gap.size:
+            line = int(np.nonzero(sel_a)[0][gap[0] + 1]) + 1
+            raise GapInputError(path, f"gap of {dt[gap[0]]:.3f} s in the wheel counts", line)
+    n = t.size
+    counts = np.zeros((n, robot.n_trucks, 2), dtype=np.int64)
+    for fid, tr in ID_WHEEL.items():
+        sel = ids == fid
+        if tr >= robot.n_trucks:
+            if sel.any():
+                raise GapInputError(
+                    path,
+                    f"frames of truck B (0x{fid:X}) but {robot.path} describes a {robot.vehicle}",
+                    int(np.argmax(sel)) + 1,
+                )
+            continue
+        if not sel.any():
+            raise GapInputError(
+                path,
+                f"no WHEEL_COUNTS_B (0x{fid:X}) frames but {robot.path} "
+                f"describes a {robot.vehicle}",
+            )
+        idx = _align(path, ts[sel], t, np.nonzero(sel)[0])
+        bits = robot.trucks[tr]["counter_bits"]
+        for w, name in enumerate(("LeftCount", "RightCount")):
+            v = decode_signal(pay[sel], lay[fid][name]).astype(np.int64)
+            if bits < 24 and (v >= (1 << bits)).any():
+                raise GapInputError(
+                    path,
+                    f"count {int(v.max())} exceeds the robot's {bits}-bit counter",
+                    int(np.nonzero(sel)[0][np.argmax(v >= (1 << bits))]) + 1,
+                )
+            counts[:, tr, w] = _fill(v, idx, n)
+    log = SensorLog(str(path), t, counts)
+    sel_r, sel_l = ids == ID_ROTARY, ids == ID_LINEAR
+    if sel_r.any():
+        idx = _align(path, ts[sel_r], t, np.nonzero(sel_r)[0])
+        log.alpha_deg = _fill(decode_signal(pay[sel_r], lay[ID_ROTARY]["Alpha"]), idx, n)
+        log.beta_deg = _fill(decode_signal(pay[sel_r], lay[ID_ROTARY]["Beta"]), idx, n)
+    if sel_l.any():
+        idx = _align(path, ts[sel_l], t, np.nonzero(sel_l)[0])
+        log.l_mm = _fill(decode_signal(pay[sel_l], lay[ID_LINEAR]["Length"]), idx, n)
+    return log
+
+
+def _align(path: Path, t_frames: np.ndarray, t_ticks: np.ndarray, lines: np.ndarray) -> np.ndarray:
+    idx = np.searchsorted(t_ticks, t_frames - 1e-7)
+    idx = np.clip(idx, 0, t_ticks.size - 1)
+    off = np.abs(t_ticks[idx] - t_frames) > 1e-5
+    if off.any():
+        raise GapInputError(
+            path,
+            "frame without a WHEEL_COUNTS_A frame of the same tick",
+            int(lines[np.argmax(off)]) + 1,
+        )
+    return idx
+
+
+def _fill(v: np.ndarray, idx: np.ndarray, n: int) -> np.ndarray:
+    """Values per tick; a tick without a frame holds the previous value (the decoder's register)."""
+    out = np.full(n, np.nan)
+    out[idx] = v
+    if np.isnan(out[0]):
+        out[0] = v[0]
+    mask = np.isnan(out)
+    if mask.any():
+        last = np.maximum.accumulate(np.where(~mask, np.arange(n), 0))
+        out = out[last]
+    return out
+
+
+@dataclass
+class Truth:
+    """A continuous ground-truth track of one run (mm, rad; angles unwrapped)."""
+
+    path: str
+    t_s: np.ndarray
+    pose: np.ndarray  # (n, trucks, 3): x_mm, y_mm, theta_rad
+    link: np.ndarray | None = None  # (n, 3): alpha_rad, beta_rad, l_mm (clapper/set)
+
+
+TRUTH_COLS = ["t_s", "a_x_mm", "a_y_mm", "a_theta_deg"]
+
+
+def read_truth(path: str | Path, robot: Robot) -> Truth:
+    path = Path(path)
+    try:
+        f = path.open(newline="")
+    except OSError as e:
+        raise GapInputError(path, f"cannot read truth: {e.strerror}") from None
+    with f:
+        rd = csv.reader(f)
+        header = next(rd, None)
+        if header is None or header[:4] != TRUTH_COLS:
+            raise GapInputError(path, f"expected a header starting {','.join(TRUTH_COLS)}", 1)
+        ncol = 10 if robot.n_trucks == 2 else 4
+        if len(header) < ncol:
+            raise GapInputError(
+                path,
+                f"a {robot.vehicle} needs truth of both trucks and the linkage (b_x_mm ... l_mm)",
+                1,
+            )
+        rows = []
+        for i, rec in enumerate(rd, start=2):
+            if not rec:
+                continue
+            try:
+                vals = [float(x) for x in rec[:ncol]]
+            except ValueError:
+                raise GapInputError(path, f"not a number in {rec[:ncol]}", i) from None
+            if len(vals) < ncol or not all(math.isfinite(v) for v in vals):
+                raise GapInputError(path, "missing or non-finite value (NaN/inf)", i)
+            if rows and vals[0] <= rows[-1][0]:
+                raise GapInputError(path, f"time {vals[0]} does not increase", i)
+            rows.append(vals)
+    if len(rows) < 10:
+        raise GapInputError(path, "fewer than 10 truth samples")
+    a = np.asarray(rows)
+    dt = np.diff(a[:, 0])
+    med = float(np.median(dt))
+    g = np.nonzero(dt > 3.5 * med)[0]
+    if g.size:
+        raise GapInputError(path, f"gap of {dt[g[0]]:.3f} s in the truth track", int(g[0]) + 3)
+    n = a.shape[0]
+    pose = np.zeros((n, robot.n_trucks, 3))
+    pose[:, 0] = np.column_stack([a[:, 1], a[:, 2], np.unwrap(np.radians(a[:, 3]))])
+    tr = Truth(str(path), a[:, 0], pose)
+    if robot.n_trucks == 2:
+        pose[:, 1] = np.column_stack([a[:, 4], a[:, 5], np.unwrap(np.radians(a[:, 6]))])
+        tr.link = np.column_stack([np.radians(a[:, 7]), np.radians(a[:, 8]), a[:, 9]])
+    return tr
+
+
+RET_COLS = [
+    "run",
+    "direction",
+    "x_abs_mm",
+    "y_abs_mm",
+    "theta_abs_deg",
+    "x_calc_mm",
+    "y_calc_mm",
+    "theta_calc_deg",
+]
+
+
+def read_returns(path: str | Path) -> dict[tuple[str, int], np.ndarray]:
+    """returns.csv (000 Eq. 3.1): (direction, run) -> true return pose x, y (mm), theta (rad)."""
+    path = Path(path)
+    try:
+        f = path.open(newline="")
+    except OSError as e:
+        raise GapInputError(path, f"cannot read: {e.strerror}") from None
+    out: dict[tuple[str, int], np.ndarray] = {}
+    with f:
+        rd = csv.reader(f)
+        if next(rd, None) != RET_COLS:
+            raise GapInputError(path, f"expected the header {','.join(RET_COLS)}", 1)
+        for i, rec in enumerate(rd, start=2):
+            try:
+                run, d = int(rec[0]), rec[1]
+                vals = [float(x) for x in rec[2:5]]
+            except (ValueError, IndexError):
+                raise GapInputError(path, "malformed row", i) from None
+            if not all(math.isfinite(v) for v in vals):
+                raise GapInputError(path, "non-finite value", i)
+            out[(d, run)] = np.array([vals[0], vals[1], math.radians(vals[2])])
+    return out
+
+
+@dataclass
+class RunData:
+    name: str  # run-cw-01
+    direction: str  # cw / ccw / fwd / ...
+    log: SensorLog
+    truth: Truth | None = None
+    ret: np.ndarray | None = None  # true return pose (returns.csv)
+
+
+def discover(real: str | Path, robot: Robot) -> list[RunData]:
+    """Every run in a folder: run-<dir>-NN.log, optional .truth.csv, optional returns.csv."""
+    real = Path(real)
+    if not real.is_dir():
+        raise GapInputError(real, "not a folder of recorded runs")
+    logs = sorted(p for p in real.iterdir() if p.name.endswith(".log"))
+    if not logs:
+        raise GapInputError(real, "no run-*.log files")
+    rets = read_returns(real / "returns.csv") if (real / "returns.csv").exists() else {}
+    runs = []
+    for p in logs:
+        m = RUN_RE.match(p.name)
+        if m is None:
+            raise GapInputError(p, "expected a name run-<direction>-NN.log")
+        d, k = m.group("dir"), int(m.group("idx"))
+        log = read_log(p, robot)
+        tp = p.with_suffix(".truth.csv")
+        truth = read_truth(tp, robot) if tp.exists() else None
+        runs.append(RunData(p.stem, d, log, truth, rets.get((d, k))))
+    return runs
+
+
+def encode_payload(fid: int, values: dict[str, np.ndarray]) -> np.ndarray:
+    """Vectorised inverse of decode_signal: uint64 payloads of frame `fid` from signal values."""
+    lay = dbc_layouts()[fid]
+    out = np.zeros(len(next(iter(values.values()))), dtype=np.uint64)
+    for name, v in values.items():
+        s = lay[name]
+        raw = np.round((np.asarray(v, dtype=float) - s.offset) / s.scale).astype(np.int64)
+        raw &= (1 << s.length) - 1
+        out |= raw.astype(np.uint64) << np.uint64(s.start)
+    return out
+
+
+FRAME_LEN = {0x110: 8, 0x111: 8, ID_ROTARY: 6, ID_LINEAR: 6}
+
+
+def write_candump(path: Path, frames: list[tuple[np.ndarray, int, np.ndarray]]) -> None:
+    """frames: (t_s, frame id, payloads) per frame kind; merged in time order, kind order kept."""
+    rows = []
+    for order, (t, fid, pay) in enumerate(frames):
+        n = FRAME_LEN[fid]
+        for ti, p in zip(t, pay, strict=False):
+            rows.append(
+                (
+                    round(float(ti), 6),
+                    order,
+                    f"({ti:.6f}) can0 {fid:03X}#{int(p).to_bytes(8, 'little')[:n].hex().upper()}",
+                )
+            )
+    rows.sort(key=lambda r: (r[0], r[1]))
+    path.write_text("\n".join(r[2] for r in rows) + "\n")

@@ -1,0 +1,183 @@
+"""The counts-driven model: what the nominal robot (plus one hypothesised effect) says the recorded
+wheel counts mean, integrated at the recorded tick (000 Eqs. 2.3-2.5 along the exact arc).
+
+A hypothesis is a dict of effect parameters (catalog names, `effect.param`); absent = nominal.
+Every function here is vectorised over ticks; one 2500-tick run dead-reckons in well under 1 ms.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .io import Robot, RunData
+
+TIRE_LOAD_KG = 100.0  # tire_compression: k * load is what kinematics sees; load fixed at default
+PHYS_DT_S = 0.001  # the plain model's idea of how fast a wheel command steps (slip)
+
+
+@dataclass
+class Prepared:
+    """Per-run arrays the model needs, computed once."""
+
+    run: RunData
+    t: np.ndarray  # (n,) tick times
+    ds: np.ndarray  # (n-1, trucks, 2) nominal wheel travel per tick (mm)
+    S: np.ndarray  # (n, trucks, 2) cumulative |travel| per wheel (bump positions)
+    b: list[float]
+    R: list[float]
+    dt: np.ndarray  # (n-1,)
+    bumps: list[dict] = field(default_factory=list)  # events placed by the bump hypothesis
+
+
+def prepare(run: RunData, robot: Robot) -> Prepared:
+    c = run.log.counts.astype(np.int64)
+    n, T = c.shape[0], c.shape[1]
+    ds = np.zeros((n - 1, T, 2))
+    for t in range(T):
+        bits = robot.trucks[t]["counter_bits"]
+        mod, half = 1 << bits, 1 << (bits - 1)
+        d = (np.diff(c[:, t, :], axis=0) + half) % mod - half  # counter wraparound
+        if robot.trucks[t]["invert_left"]:
+            d[:, 0] = -d[:, 0]
+        if robot.trucks[t]["invert_right"]:
+            d[:, 1] = -d[:, 1]
+        ds[:, t, :] = d * robot.mm_per_count(t)
+    S = np.concatenate([np.zeros((1, T, 2)), np.cumsum(np.abs(ds), axis=0)])
+    return Prepared(
+        run,
+        run.log.t_s,
+        ds,
+        S,
+        [robot.trucks[t]["wheelbase_mm"] for t in range(T)],
+        [0.5 * robot.trucks[t]["wheel_diameter_mm"] for t in range(T)],
+        np.diff(run.log.t_s),
+    )
+
+
+# ------------------------------------------------------------------------------------------------
+# bump geometry (004 Eqs. 1-5, host_sim/src/bump.c 'exact': pivot about the step's edge)
+# ------------------------------------------------------------------------------------------------
+def bump_dd(R: float, h: np.ndarray | float) -> np.ndarray:
+    """Excess rotation arc over horizontal travel for one whole bump: 2 (R psi0 - D_hor)."""
+    h = np.clip(np.asarray(h, dtype=float), 0.0, 0.999 * R)
+    return 2.0 * (R * np.arccos(1.0 - h / R) - np.sqrt(np.maximum(2 * R * h - h * h, 0.0)))
+
+
+def bump_excess(R: float, h: float, s: np.ndarray) -> np.ndarray:
+    """Cumulative excess after s mm of rotation arc since first contact (climb, then mirrored)."""
+    h = min(max(h, 1e-9), 0.999 * R)
+    psi0 = math.acos(1.0 - h / R)
+    dhor = math.sqrt(max(2 * R * h - h * h, 0.0))
+    half_arc = R * psi0
+    e_half = half_arc - dhor
+    s = np.clip(s, 0.0, 2 * half_arc)
+    climb = lambda x: x - (dhor - R * np.sin(psi0 - x / R))  # noqa: E731
+    return np.where(s <= half_arc, climb(s), 2 * e_half - climb(2 * half_arc - s))
+
+
+# ------------------------------------------------------------------------------------------------
+# wheel floor travel under a hypothesis
+# ------------------------------------------------------------------------------------------------
+def wheel_factors(P: dict, R: float, b: float) -> tuple[float, float]:
+    """Floor travel per unit of nominal travel, left and right (ed, es, tyre compression)."""
+    ed = P.get("ed.value", 1.0)
+    gl, gr = 2.0 / (ed + 1.0), 2.0 / (1.0 / ed + 1.0)  # 000 Eqs. 6.30-6.32
+    es = P.get("es.value", 1.0)
+    gl, gr = gl / es, gr / es  # 000 App. B
+    k = P.get("tire_compression.k_mm_per_kg", 0.0)
+    if k:
+        off = P.get("tire_compression.lateral_offset_mm", 0.0)
+        m = P.get("tire_compression.load_kg", TIRE_LOAD_KG)
+        gl *= (R - k * m * (0.5 * b + off) / b) / R
+        gr *= (R - k * m * (0.5 * b - off) / b) / R
+    return gl, gr
+
+
+def rough_moments(R: float, hmax: float, n: int = 64) -> tuple[float, float]:
+    """Mean and mean square of one roughness grain's excess, heights uniform in [0, hmax]."""
+    u = (np.arange(n) + 0.5) / n * hmax
+    dd = bump_dd(R, u)
+    return float(dd.mean()), float((dd * dd).mean())
+
+
+def floor_travel(pr: Prepared, P: dict, truck: int) -> tuple[np.ndarray, float, np.ndarray]:
+    """(n-1, 2) floor travel per tick, true wheelbase, (n-1,) lateral skid per tick (mm)."""
+    ds = pr.ds[:, truck, :].copy()
+    R, b = pr.R[truck], pr.b[truck]
+    gl, gr = wheel_factors(P, R, b)
+    ds[:, 0] *= gl
+    ds[:, 1] *= gr
+    hr = P.get("roughness.max_height_mm", 0.0)
+    if hr > 0:
+        m1, _ = rough_moments(R, hr)
+        ds *= 1.0 - m1 / P.get("roughness.spacing_mm", 20.0)
+    k = P.get("slip.k_per_m_s2", 0.0)
+    if k > 0:
+        v = pr.ds[:, truck, :] / pr.dt[:, None]  # mm/s surface speed
+        vp = np.vstack([np.zeros((1, 2)), v[:-1]])
+        a = np.abs(v - vp) / PHYS_DT_S * 1e-3  # m/s^2 over one step
+        s = np.minimum(
+            k * np.maximum(a - P.get("slip.a0_m_s2", 0.5), 0.0), P.get("slip.max_fraction", 0.2)
+        )
+        up = np.abs(v) >= np.abs(vp)
+        corr = np.where(up, -s, s / (1.0 - s)) * v * PHYS_DT_S
+        ds += corr
+    for ev in pr.bumps:
+        if ev["truck"] != truck:
+            continue
+        w = ev["wheel"]
+        S = pr.S[:, truck, w]
+        e = bump_excess(R, ev["h"], S - ev["s0"])
+        ds[:, w] -= np.sign(pr.ds[:, truck, w]) * np.diff(e)
+    bt = b * P.get("eb.value", 1.0)
+    lat = np.zeros(ds.shape[0])
+    ks = P.get("skid.k_s", 0.0)
+    if ks > 0:
+        v = 0.5 * (ds[:, 0] + ds[:, 1]) / pr.dt
+        om = (ds[:, 1] - ds[:, 0]) / bt / pr.dt
+        ac = v * om * 1e-3
+        ex = np.maximum(np.abs(ac) - P.get("skid.a0_m_s2", 0.3), 0.0)
+        lat = -np.sign(ac) * ks * ex * 1e3 * pr.dt
+    return ds, bt, lat
+
+
+def integrate(ds: np.ndarray, b: float, lat: np.ndarray, pose0=(0.0, 0.0, 0.0)) -> np.ndarray:
+    """Dead reckoning along the exact arc of each tick; returns (n, 3) x, y, theta."""
+    d = 0.5 * (ds[:, 0] + ds[:, 1])
+    dth = (ds[:, 1] - ds[:, 0]) / b
+    th = pose0[2] + np.concatenate([[0.0], np.cumsum(dth)])
+    half = 0.5 * dth
+    with np.errstate(invalid="ignore", divide="ignore"):
+        chord = np.where(np.abs(half) > 1e-9, d * np.sin(half) / np.where(half == 0, 1, half), d)
+    mid = th[:-1] + half
+    dx = chord * np.cos(mid) - lat * np.sin(mid)
+    dy = chord * np.sin(mid) + lat * np.cos(mid)
+    x = pose0[0] + np.concatenate([[0.0], np.cumsum(dx)])
+    y = pose0[1] + np.concatenate([[0.0], np.cumsum(dy)])
+    return np.column_stack([x, y, th])
+
+
+def dead_reckon(pr: Prepared, P: dict, truck: int = 0, pose0=(0.0, 0.0, 0.0)) -> np.ndarray:
+    ds, bt, lat = floor_travel(pr, P, truck)
+    return integrate(ds, bt, lat, pose0)
+
+
+def link_bias(P: dict, alpha: np.ndarray, beta: np.ndarray) -> tuple:
+    """What rotary_bias / link_bias add to the true linkage readings (deg, deg, mm)."""
+    ba = P.get("rotary_bias.alpha_deg", 0.0)
+    bb = P.get("rotary_bias.beta_deg", 0.0)
+    bl = P.get("link_bias.const_mm", 0.0) + P.get("link_bias.ecc_mm", 0.0) * (
+        1 - np.cos(alpha - beta)
+    )
+    return ba, bb, bl
+
+
+def wrap_deg(a: np.ndarray) -> np.ndarray:
+    return (np.asarray(a) + 180.0) % 360.0 - 180.0
+
+
+def wrap_rad(a: np.ndarray) -> np.ndarray:
+    return (np.asarray(a) + math.pi) % (2 * math.pi) - math.pi

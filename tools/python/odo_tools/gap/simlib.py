@@ -1,0 +1,131 @@
+"""libodosim through ctypes (host_sim/include/odosim/odosim.h): the effects catalog for the
+diagnosis, and odosim_run_ex for the blind check's "real" runs."""
+
+from __future__ import annotations
+
+import ctypes as C
+import json
+import os
+from functools import lru_cache
+from pathlib import Path
+
+from .errors import GapInputError
+from .io import source_dir
+
+
+class RowEx(C.Structure):
+    _fields_ = [
+        ("t_s", C.c_double),
+        ("t_us", C.c_uint64),
+        ("truth", (C.c_double * 3) * 2),
+        ("link_true", C.c_double * 3),
+        ("counts", (C.c_uint32 * 2) * 2),
+        ("wheel_seq", C.c_uint8 * 2),
+        ("wheel_status", C.c_uint8 * 2),
+        ("wheel_present", C.c_uint8 * 2),
+        ("rotary_present", C.c_uint8),
+        ("linear_present", C.c_uint8),
+        ("rotary_status", C.c_uint8),
+        ("linear_status", C.c_uint8),
+        ("rotary_seq", C.c_uint8),
+        ("linear_seq", C.c_uint8),
+        ("alpha_bam16", C.c_uint16),
+        ("beta_bam16", C.c_uint16),
+        ("length_um", C.c_uint32),
+        ("n_events", C.c_uint32),
+    ]
+
+
+class Event(C.Structure):
+    _fields_ = [(n, C.c_double) for n in ("t_s", "x_mm", "y_mm", "height_mm", "at_distance_mm")] + [
+        ("truck", C.c_uint32),
+        ("wheel", C.c_uint32),
+    ]
+
+
+class Result(C.Structure):
+    _fields_ = [
+        (n, C.c_double)
+        for n in (
+            "x_abs_mm",
+            "y_abs_mm",
+            "theta_abs_deg",
+            "x_calc_mm",
+            "y_calc_mm",
+            "theta_calc_deg",
+            "ex_mm",
+            "ey_mm",
+            "etheta_deg",
+            "t_end_s",
+        )
+    ] + [("n_ticks", C.c_size_t)]
+
+
+class Opts(C.Structure):
+    _fields_ = [
+        ("experiment", C.c_char_p),
+        ("ccw", C.c_int),
+        ("bumps", C.c_int),
+        ("bump_height_mm", C.c_double),
+        ("ipec", C.c_int),
+        ("seed", C.c_uint64),
+        ("run_index", C.c_uint),
+        ("physics_dt_s", C.c_double),
+        ("motor_tau_s", C.c_double),
+        ("diam_var_amp", C.c_double),
+        ("diam_var_period_s", C.c_double),
+        ("diam_drift_per_s", C.c_double),
+        ("backlash_rad", C.c_double),
+    ]
+
+
+def lib_path() -> Path:
+    cands = []
+    if os.environ.get("ODO_BUILD_DIR"):
+        cands.append(Path(os.environ["ODO_BUILD_DIR"]) / "lib" / "libodosim.so")
+    root = source_dir()
+    cands += [root / "build" / d / "lib" / "libodosim.so" for d in ("host", "release", "h-gap")]
+    cands += sorted((root / "build").glob("*/lib/libodosim.so"))
+    for c in cands:
+        if c.is_file():
+            return c
+    raise GapInputError(
+        root / "build", "libodosim.so not found: build first (make build) or set ODO_BUILD_DIR"
+    )
+
+
+@lru_cache(maxsize=1)
+def lib() -> C.CDLL:
+    so = C.CDLL(str(lib_path()))
+    so.odosim_setup_parse.restype = C.c_void_p
+    so.odosim_setup_parse.argtypes = [C.c_char_p, C.c_char_p, C.c_char_p, C.c_size_t]
+    so.odosim_setup_free.argtypes = [C.c_void_p]
+    so.odosim_run_seed.restype = C.c_uint64
+    so.odosim_run_seed.argtypes = [C.c_uint64, C.c_int, C.c_uint]
+    so.odosim_run_ex.argtypes = [
+        C.c_void_p,
+        C.POINTER(Opts),
+        C.POINTER(RowEx),
+        C.c_size_t,
+        C.POINTER(Event),
+        C.c_size_t,
+        C.POINTER(C.c_size_t),
+        C.POINTER(Result),
+        C.c_char_p,
+        C.c_size_t,
+    ]
+    so.odosim_effects_json.restype = C.c_void_p
+    so.odosim_free.argtypes = [C.c_void_p]
+    return so
+
+
+@lru_cache(maxsize=1)
+def catalog() -> dict[str, dict]:
+    """THE effects catalog (host_sim/src/effects.c), by effect name."""
+    so = lib()
+    p = so.odosim_effects_json()
+    try:
+        doc = json.loads(C.string_at(p).decode())
+    finally:
+        so.odosim_free(p)
+    return {e["name"]: e for e in doc["effects"]}
