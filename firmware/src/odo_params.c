@@ -478,3 +478,36 @@ const char *odo_params_status_str(odo_params_status_t s)
     }
     return "unknown status";
 }
+
+const char *odo_params_field_name(odo_param_field_t f)
+{
+    switch (f) {
+    case ODO_PF_NONE: return "none";
+    case ODO_PF_VEHICLE: return "vehicle";
+    case ODO_PF_COUNTER_BITS: return "counter_bits";
+    case ODO_PF_HEADING_FORM: return "heading_form";
+    case ODO_PF_IPEC_MODE: return "ipec_mode";
+    case ODO_PF_TICK_US: return "tick_us";
+    case ODO_PF_MAX_WHEEL_SPEED: return "max_wheel_speed_mm_s";
+    case ODO_PF_WHEEL_DIAMETER: return "wheel_diameter_nm";
+    case ODO_PF_COUNTS_PER_REV: return "counts_per_rev_milli";
+    case ODO_PF_WHEELBASE: return "wheelbase_nm";
+    case ODO_PF_ED: return "ed_q30";
+    case ODO_PF_EB: return "eb_q30";
+    case ODO_PF_ES: return "es_q30";
+    case ODO_PF_TRUCK_FLAGS: return "flags";
+    case ODO_PF_LINK_LENGTH: return "link.length_nm";
+    case ODO_PF_HITCH_OFFSET: return "link.hitch_offset_nm";
+    case ODO_PF_LENGTH_BIAS: return "link.length_bias_nm";
+    case ODO_PF_LENGTH_ECC: return "link.length_ecc_nm";
+    case ODO_PF_ALPHA_BIAS: return "link.alpha_bias_bam";
+    case ODO_PF_BETA_BIAS: return "link.beta_bias_bam";
+    case ODO_PF_ROTARY_BITS: return "link.rotary_bits";
+    case ODO_PF_STALE_TICKS: return "link.stale_ticks";
+    case ODO_PF_MAX_JUMP: return "link.max_jump_bam";
+    case ODO_PF_MAX_LENGTH_JUMP: return "link.max_length_jump_um";
+    case ODO_PF_LENGTH_RANGE: return "link.length_min_um/link.length_max_um";
+    case ODO_PF_RESERVED: return "reserved";
+    }
+    return "unknown";
+}

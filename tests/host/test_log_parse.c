@@ -2,7 +2,7 @@
 /// read back exactly (standard and extended IDs, empty data, RTR with and without a DLC, error
 /// frames, the optional " R"/" T"), every malformed class is rejected with its reason, and the
 /// reader names the file and line. The formatter and the parser round-trip every frame shape.
-#include <check.h>
+#include "check_support.h"
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -242,9 +242,5 @@ static Suite *suite(void)
 
 int main(void)
 {
-    SRunner *sr = srunner_create(suite());
-    srunner_run_all(sr, CK_NORMAL);
-    const int failed = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return failed == 0 ? EXIT_SUCCESS : EXIT_FAILURE;
+    return ts_run_suite(suite());
 }

@@ -3,7 +3,7 @@
 /// then the message says so and names the modules to load), and a failed handle is inert. The
 /// working paths (frames, timestamps, interface down/up, error frames) run on a real kernel in
 /// vcan.qemu_replay.
-#include <check.h>
+#include "check_support.h"
 #include <stdlib.h>
 #include <string.h>
 
@@ -51,9 +51,5 @@ int main(void)
     tcase_add_test(tc, missing_interface_is_a_clear_error);
     tcase_add_test(tc, bad_names_and_too_many_filters);
     suite_add_tcase(su, tc);
-    SRunner *sr = srunner_create(su);
-    srunner_run_all(sr, CK_NORMAL);
-    const int failed = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return failed == 0 ? EXIT_SUCCESS : EXIT_FAILURE;
+    return ts_run_suite(su);
 }

@@ -1,7 +1,7 @@
 /// hal_log behind hal/hal.h (issue 6 item 2): hal_can_recv feeds a candump log's frames in file
 /// order with their timestamps, hal_time_us follows them, hal_can_send writes candump lines that
 /// read back as the frames sent, and a backend without counters says so (hal_wheel_read false).
-#include <check.h>
+#include "check_support.h"
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -90,9 +90,5 @@ int main(void)
     tcase_add_test(tc, frames_in_order_with_their_timestamps);
     tcase_add_test(tc, a_malformed_line_stops_the_feed_with_its_line_number);
     suite_add_tcase(su, tc);
-    SRunner *sr = srunner_create(su);
-    srunner_run_all(sr, CK_NORMAL);
-    const int failed = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return failed == 0 ? EXIT_SUCCESS : EXIT_FAILURE;
+    return ts_run_suite(su);
 }

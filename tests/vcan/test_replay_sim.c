@@ -5,7 +5,7 @@
 /// error-frame burst, unknown IDs, wrong DLC, time going backwards) never crash the loop, are
 /// flagged in the STATUS frame, and move the pose by a bounded amount relative to the clean replay
 /// (measured and printed; the bounds below are the measured figures with margin).
-#include <check.h>
+#include "check_support.h"
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -428,11 +428,8 @@ int main(void)
     run_sim(1);
     g_n_clean = read_log(g_sim[0].log_path, g_clean, MAX_FRAMES);
     replay_frames(g_clean, g_n_clean, &g_params[0], &g_run_a, NULL); /* the clean reference */
-    SRunner *sr = srunner_create(suite());
-    srunner_run_all(sr, CK_NORMAL);
-    const int failed = srunner_ntests_failed(sr);
-    srunner_free(sr);
+    const int failed = ts_run_suite(suite());
     remove(g_sim[0].log_path);
     remove(g_sim[1].log_path);
-    return failed == 0 ? EXIT_SUCCESS : EXIT_FAILURE;
+    return failed;
 }

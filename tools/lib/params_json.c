@@ -96,39 +96,6 @@ static int read_fields(json_t *o, const field_t *f, size_t n, void *base, const 
     return 0;
 }
 
-static const char *pf_name(odo_param_field_t f)
-{
-    switch (f) {
-    case ODO_PF_VEHICLE: return "vehicle";
-    case ODO_PF_COUNTER_BITS: return "counter_bits";
-    case ODO_PF_HEADING_FORM: return "heading_form";
-    case ODO_PF_IPEC_MODE: return "ipec_mode";
-    case ODO_PF_TICK_US: return "tick_us";
-    case ODO_PF_MAX_WHEEL_SPEED: return "max_wheel_speed_mm_s";
-    case ODO_PF_WHEEL_DIAMETER: return "wheel_diameter_nm";
-    case ODO_PF_COUNTS_PER_REV: return "counts_per_rev_milli";
-    case ODO_PF_WHEELBASE: return "wheelbase_nm";
-    case ODO_PF_ED: return "ed_q30";
-    case ODO_PF_EB: return "eb_q30";
-    case ODO_PF_ES: return "es_q30";
-    case ODO_PF_TRUCK_FLAGS: return "flags";
-    case ODO_PF_LINK_LENGTH: return "link.length_nm";
-    case ODO_PF_HITCH_OFFSET: return "link.hitch_offset_nm";
-    case ODO_PF_LENGTH_BIAS: return "link.length_bias_nm";
-    case ODO_PF_LENGTH_ECC: return "link.length_ecc_nm";
-    case ODO_PF_ALPHA_BIAS: return "link.alpha_bias_bam";
-    case ODO_PF_BETA_BIAS: return "link.beta_bias_bam";
-    case ODO_PF_ROTARY_BITS: return "link.rotary_bits";
-    case ODO_PF_STALE_TICKS: return "link.stale_ticks";
-    case ODO_PF_MAX_JUMP: return "link.max_jump_bam";
-    case ODO_PF_MAX_LENGTH_JUMP: return "link.max_length_jump_um";
-    case ODO_PF_LENGTH_RANGE: return "link.length_min_um/length_max_um";
-    case ODO_PF_NONE:
-    case ODO_PF_RESERVED: break;
-    }
-    return "reserved";
-}
-
 int odo_params_json_parse(const char *text, const char *origin, odo_params_t *out, char *err, size_t errlen)
 {
     json_error_t je;
@@ -201,9 +168,9 @@ int odo_params_json_parse(const char *text, const char *origin, odo_params_t *ou
     if (odo_params_validate(&p, &bad, &bad_truck) != ODO_PARAMS_OK) {
         if (bad >= ODO_PF_WHEEL_DIAMETER && bad <= ODO_PF_TRUCK_FLAGS) {
             snprintf(err, errlen, "%s: truck[%u].%s: outside the documented range (odo_params.h)", origin,
-                     (unsigned)bad_truck, pf_name(bad));
+                     (unsigned)bad_truck, odo_params_field_name(bad));
         } else {
-            snprintf(err, errlen, "%s: %s: outside the documented range (odo_params.h)", origin, pf_name(bad));
+            snprintf(err, errlen, "%s: %s: outside the documented range (odo_params.h)", origin, odo_params_field_name(bad));
         }
         goto done;
     }

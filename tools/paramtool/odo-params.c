@@ -187,39 +187,6 @@ static uint32_t le32(const uint8_t *b)
     return (uint32_t)b[0] | ((uint32_t)b[1] << 8) | ((uint32_t)b[2] << 16) | ((uint32_t)b[3] << 24);
 }
 
-static const char *field_name(odo_param_field_t f)
-{
-    switch (f) {
-    case ODO_PF_NONE: return "none";
-    case ODO_PF_VEHICLE: return "vehicle";
-    case ODO_PF_COUNTER_BITS: return "counter_bits";
-    case ODO_PF_HEADING_FORM: return "heading_form";
-    case ODO_PF_IPEC_MODE: return "ipec_mode";
-    case ODO_PF_TICK_US: return "tick_us";
-    case ODO_PF_MAX_WHEEL_SPEED: return "max_wheel_speed_mm_s";
-    case ODO_PF_WHEEL_DIAMETER: return "wheel_diameter_nm";
-    case ODO_PF_COUNTS_PER_REV: return "counts_per_rev_milli";
-    case ODO_PF_WHEELBASE: return "wheelbase_nm";
-    case ODO_PF_ED: return "ed_q30";
-    case ODO_PF_EB: return "eb_q30";
-    case ODO_PF_ES: return "es_q30";
-    case ODO_PF_TRUCK_FLAGS: return "flags";
-    case ODO_PF_LINK_LENGTH: return "link.length_nm";
-    case ODO_PF_HITCH_OFFSET: return "link.hitch_offset_nm";
-    case ODO_PF_LENGTH_BIAS: return "link.length_bias_nm";
-    case ODO_PF_LENGTH_ECC: return "link.length_ecc_nm";
-    case ODO_PF_ALPHA_BIAS: return "link.alpha_bias_bam";
-    case ODO_PF_BETA_BIAS: return "link.beta_bias_bam";
-    case ODO_PF_ROTARY_BITS: return "link.rotary_bits";
-    case ODO_PF_STALE_TICKS: return "link.stale_ticks";
-    case ODO_PF_MAX_JUMP: return "link.max_jump_bam";
-    case ODO_PF_MAX_LENGTH_JUMP: return "link.max_length_jump_um";
-    case ODO_PF_LENGTH_RANGE: return "link.length_min_um/link.length_max_um";
-    case ODO_PF_RESERVED: return "reserved";
-    }
-    return "unknown";
-}
-
 /// The offending value, for the message. Length range: the minimum (the pair is named together).
 static long long field_value(const odo_params_t *p, odo_param_field_t f, unsigned t)
 {
@@ -369,9 +336,9 @@ static void diagnose(odo_params_status_t st, const uint8_t *b, size_t n, char *d
         }
         (void)odo_params_validate(&p, &f, &t);
         if (is_truck_field(f)) {
-            snprintf(field, fcap, "truck[%u].%s", (unsigned)t, field_name(f));
+            snprintf(field, fcap, "truck[%u].%s", (unsigned)t, odo_params_field_name(f));
         } else {
-            snprintf(field, fcap, "%s", field_name(f));
+            snprintf(field, fcap, "%s", odo_params_field_name(f));
         }
         if (f == ODO_PF_LENGTH_RANGE) {
             snprintf(detail, dcap, "field %s = %" PRIu32 "/%" PRIu32 " is outside its documented range",

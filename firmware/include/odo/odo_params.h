@@ -164,6 +164,10 @@ uint32_t odo_crc32(const uint8_t *data, size_t len);
 /// Static English text for a status, for host tools' messages.
 const char *odo_params_status_str(odo_params_status_t s);
 
+/// The field's name as the JSON tools spell it ("link.rotary_bits", "ed_q30"; truck fields without
+/// their truck index); "none" and "reserved" for those two values.
+const char *odo_params_field_name(odo_param_field_t f);
+
 #ifdef __cplusplus
 }
 #endif
