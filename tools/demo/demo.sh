@@ -38,3 +38,8 @@ if [ -f build/cm4/bin/odo_image.elf ]; then
 fi
 "$BIN/odo-calib" export --params "$OUT/calibrated.json" --format ros2 > "$OUT/calibrated-ros2.yaml"
 echo "ros2 diff_drive_controller multipliers: $OUT/calibrated-ros2.yaml"
+
+# The sim-to-real gap (issue 7): "real" runs with an effect the diagnosis is not told, diagnosed
+# from the recorded frames and truth alone.
+echo
+bash tools/demo/gap_demo.sh "$PWD/build/host" "$OUT/gap"
