@@ -1,6 +1,8 @@
 """odo-gap blind (issue 7 item 3), small and seeded: the generator withholds each case's effect,
 the diagnosing processes cannot open the keys, and loose versions of the targets hold. The full
-acceptance run is `odo-gap blind --cases 60 --seed 1 --out out/blind` (prints the figures)."""
+acceptance run is `odo-gap blind --cases 60 --seed 4 --out out/blind` (prints the figures; README).
+Seed 5's eight cases hold a no-effect LabMate-with-trailer (the vehicle that used to raise false
+alarms), ed, eb, roughness and four out-of-catalog cases."""
 
 from __future__ import annotations
 
@@ -30,9 +32,12 @@ def test_scores_have_every_figure(blind: Path) -> None:
         assert k in s, k
     assert (blind / "scores.png").read_bytes()[:4] == b"\x89PNG"
     assert s["cases"] == 8 and sum(sum(v.values()) for v in s["confusion"].values()) == 8
-    # loose targets on 8 cases
-    if s["top1_cases"]:
-        assert s["top1_accuracy"] >= 0.5
+    # loose versions of the targets on 8 cases (README "Measured" has the 60-case figures)
+    assert s["top1_cases"] >= 3 and s["top1_accuracy"] >= 0.6
+    assert s["no_effect_cases"] >= 1 and s["false_alarm_rate"] == 0.0
+    assert s["out_of_catalog_cases"] >= 3 and s["unexplained_rate_out_of_catalog"] >= 0.5
+    assert s["param_rel_err_median"] <= 0.1
+    assert s["shrink_median"] >= 5.0
     assert s["diagnose_10runs_s"] < 30
 
 

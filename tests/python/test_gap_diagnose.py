@@ -32,7 +32,8 @@ def report(tmp_path_factory: pytest.TempPathFactory) -> Path:
 def test_unequal_wheel_diameters_are_found_sized_and_removed(report: Path) -> None:
     rep = json.loads((report / "report.json").read_text())
     for k in ("verdict", "runner_up", "where", "gap_before", "gap_after_heldout", "shrink",
-              "shrink_ci", "unidentifiable"):
+              "shrink_ci", "unidentifiable", "gap_definition", "gap_before_mm",
+              "gap_after_heldout_mm", "shrink_mm"):
         assert k in rep
     v = rep["verdict"]
     assert v["effect"] == "ed"
@@ -40,6 +41,7 @@ def test_unequal_wheel_diameters_are_found_sized_and_removed(report: Path) -> No
     assert v["evidence"]["dbic_vs_nominal"] > 10
     assert rep["runner_up"]["margin_dbic"] > 0
     assert rep["shrink"] > 10 and rep["shrink_ci"][0] > 1
+    assert rep["shrink_mm"] > 10 and rep["gap_after_heldout_mm"] < rep["gap_before_mm"]
     assert set(rep["heldout_runs"]).isdisjoint(rep["fit_runs"])
     assert {r.split("-")[1] for r in rep["heldout_runs"]} == {"cw", "ccw"}  # stratified
     assert any(u["what"] == "tire_compression" for u in rep["unidentifiable"])

@@ -27,7 +27,7 @@ FREE = {
     "eb": ["value"],
     "es": ["value"],
     "roughness": ["max_height_mm"],
-    "slip": ["k_per_m_s2"],
+    "slip": ["k_per_m_s2", "tau_s"],
     "skid": ["k_s"],
     "rotary_bias": ["alpha_deg", "beta_deg"],
     "link_bias": ["const_mm", "ecc_mm"],
@@ -68,7 +68,13 @@ def free_params(effect: str, vehicle: str) -> list[str]:
     return [f"{effect}.{p}" for p in f]
 
 
+# model-side nuisances that are not catalog parameters: (min, max, start)
+NUISANCE = {"slip.tau_s": (0.0005, 0.02, 0.004)}
+
+
 def bounds(key: str) -> tuple[float, float, float]:
+    if key in NUISANCE:
+        return NUISANCE[key]
     e, p = key.split(".")
     d = next(x for x in catalog()[e]["params"] if x["name"] == p)
     return float(d["min"]), float(d["max"]), float(d["default"])
@@ -116,7 +122,9 @@ def estimate_sigma(items: list, mode: str) -> np.ndarray:
     if mode == "returns":
         # no repeated-measurement floor exists: the spread of the runs around their direction's
         # mean is the non-systematic part (000 s. 3.3); a floor keeps it from vanishing
-        dirs = np.array([it.pr.run.direction for it in items])
+        # runs of the same path: same direction and the same travel (UMBmark squares and
+        # rectangles differ systematically; grouping them by direction only made that "noise")
+        dirs = np.array([group_key(it.pr) for it in items])
         dev = np.vstack([r[dirs == d] - r[dirs == d].mean(axis=0) for d in np.unique(dirs)])
         s = np.sqrt(np.sum(dev**2, axis=0) / max(1, r.shape[0] - np.unique(dirs).size))
         return np.maximum(s, np.array([0.5, 0.5, 1e-4]))
@@ -128,15 +136,19 @@ def estimate_sigma(items: list, mode: str) -> np.ndarray:
                 floor[c] = items[0].q_l_mm
         st = np.concatenate([it.stationary() for it in items])
         if st.sum() >= 8:
-            s = 1.4826 * np.median(np.abs(r[st]), axis=0)
+            # spread about the median: a constant reading offset (rotary_bias, link_bias) on a
+            # resting vehicle is the systematic gap itself, not noise
+            rs = r[st]
+            s = 1.4826 * np.median(np.abs(rs - np.median(rs, axis=0)), axis=0)
             return np.maximum(s, floor)
+    if mode == "linkage":
+        # the end reading's quantisation (the start's is profiled out, modes.LinkageMode),
+        # unless the profiled residuals show more
+        floor = items[0].floor
+        s = 1.4826 * np.median(np.abs(r - np.median(r, axis=0)), axis=0)
+        return np.maximum(s, floor)
     d = np.diff(r, axis=0)
     s = 1.4826 * np.median(np.abs(d - np.median(d, axis=0)), axis=0) / math.sqrt(2)
-    if mode == "linkage":
-        q = items[0].q_rad
-        floor = np.array(
-            [q, q if items[0].clapper else 0.05, 0.05 / math.sqrt(12) if items[0].clapper else 0.05]
-        )
     return np.maximum(s, floor)
 
 
@@ -156,12 +168,18 @@ class Fit:
         return self.dev + self.k * math.log(max(self.n, 2))
 
 
-def fit_params(prob: Problem, keys: list[str], base: dict | None = None) -> tuple[dict, dict]:
+def fit_params(
+    prob: Problem, keys: list[str], base: dict | None = None, warm: dict | None = None
+) -> tuple[dict, dict]:
+    """Bounded least squares of `keys` (others from `base`). `warm`: start values (pairs start
+    from their singles' fits, one start; else the catalog start and, for slip/skid, a second)."""
     base = dict(base or {})
     if not keys:
         return base, {}
     lo, hi, x0 = zip(*(bounds(k) for k in keys), strict=False)
     x0 = [START.get(k, d) for k, d in zip(keys, x0, strict=False)]
+    if warm:
+        x0 = [warm.get(k, v) for k, v in zip(keys, x0, strict=False)]
 
     def f(x):
         P = dict(base)
@@ -170,7 +188,7 @@ def fit_params(prob: Problem, keys: list[str], base: dict | None = None) -> tupl
 
     best = None
     starts = [x0]
-    if any(k.startswith(("slip", "skid")) for k in keys):
+    if not warm and any(k.startswith(("slip", "skid")) for k in keys):
         starts.append(
             [
                 min(h, 0.5) if k.startswith(("slip", "skid")) else s
@@ -353,7 +371,11 @@ def cluster_bumps(events: list[dict], tol_mm: float = 80.0) -> list[dict]:
     return out
 
 
-def place_bumps(prs: list[Prepared], floor_bumps: list[dict], h: float | None = None) -> None:
+def place_bumps(
+    prs: list[Prepared], floor_bumps: list[dict], h: float | None = None, own: bool = False
+) -> None:
+    """Put floor bumps on the runs of their path; `own`: only on the runs whose own events made
+    them (fitting: a path's runs need not share their bumps - rect-7x4 alternates the wheel)."""
     for pr in prs:
         g = group_key(pr)
         pr.bumps = [
@@ -364,7 +386,7 @@ def place_bumps(prs: list[Prepared], floor_bumps: list[dict], h: float | None = 
                 "h": h if h is not None else b["h"],
             }
             for b in floor_bumps
-            if b["group"] == g
+            if b["group"] == g and (not own or pr.run.name in b.get("runs", ()))
         ]
 
 

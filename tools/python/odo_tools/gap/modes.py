@@ -20,12 +20,27 @@ from .model import Prepared, dead_reckon, link_bias, rough_moments, wrap_rad
 
 WINDOW_S = 0.4  # truth increments: window length
 HORIZON_S = 1.0  # linkage mode: prediction horizon
+ANCHOR_S = 2.0  # truth mode: the start pose is fitted over this much of the run
 
 
 def _body_inc(p: np.ndarray, i: np.ndarray, j: np.ndarray) -> np.ndarray:
     dx, dy = p[j, 0] - p[i, 0], p[j, 1] - p[i, 1]
     c, s = np.cos(p[i, 2]), np.sin(p[i, 2])
     return np.column_stack([c * dx + s * dy, -s * dx + c * dy, p[j, 2] - p[i, 2]])
+
+
+def _censored(x: np.ndarray, code: np.ndarray, step: float, angle: bool) -> np.ndarray:
+    """Residual of a truncating encoder: code k means the measured value lies in [k, k + step).
+
+    The residual is how far the model's value x lies outside that cell (reading minus model,
+    zero inside): interval-censored data. Replacing the cell by its centre is biased whenever the
+    value rests for a while, e.g. a straight linkage at exactly 0 reads code 0 with zero error,
+    not half a step (that bias was the clapper/set false alarm)."""
+    d = x - code
+    if angle:
+        d = wrap_rad(d)
+    tol = 1e-9 * max(step, 1.0) + 1e-7 * step
+    return np.clip(d, -tol, step + tol) - d
 
 
 class TruthMode:
@@ -52,23 +67,22 @@ class TruthMode:
         )
         lg = pr.run.log
         self.has_link = self.tlink is not None and lg.alpha_deg is not None
+        bits = robot.linkage.get("rotary_bits", robot.trailer.get("rotary_bits", 10))
+        self.step_rad = 2 * math.pi / (1 << bits)
+        self.step_l_mm = max(robot.linkage.get("linear_resolution_mm", 0.1), 1e-3)
+        self.q_rad = self.step_rad / math.sqrt(12)
+        self.q_l_mm = self.step_l_mm / math.sqrt(12)
         if self.has_link:
+            # the reading in force at each truth sample (zero-order hold: a code is not a
+            # continuous signal, interpolating between codes would invent values)
+            k = np.clip(np.searchsorted(pr.t, self.tt + 1e-9, side="right") - 1, 0, pr.t.size - 1)
             self.meas = np.column_stack(
                 [
-                    np.interp(self.tt, pr.t, lg.alpha_deg),
-                    np.interp(self.tt, pr.t, lg.beta_deg),
-                    np.interp(
-                        self.tt, pr.t, lg.l_mm if lg.l_mm is not None else np.zeros_like(pr.t)
-                    ),
+                    np.radians(lg.alpha_deg[k]),
+                    np.radians(lg.beta_deg[k]) if lg.beta_deg is not None else np.zeros(k.size),
+                    lg.l_mm[k] if lg.l_mm is not None else np.zeros(k.size),
                 ]
             )
-        bits = robot.linkage.get("rotary_bits", robot.trailer.get("rotary_bits", 10))
-        self.q_rad = 2 * math.pi / (1 << bits) / math.sqrt(12)
-        self.q_l_mm = max(robot.linkage.get("linear_resolution_mm", 0.1), 1e-3) / math.sqrt(12)
-        if self.has_link:  # the encoders truncate: code k reads the middle of its step
-            self.meas += [math.degrees(self.q_rad) * math.sqrt(3)] * 2 + [
-                self.q_l_mm * math.sqrt(3)
-            ]
         # nominal travel in each window (roughness variance; stationary detection)
         S = pr.S
         self.wtravel = np.stack(
@@ -106,13 +120,48 @@ class TruthMode:
         if self.has_link:
             tl = self.tlink[self.i]
             ba, bb, bl = link_bias(P, tl[:, 0], tl[:, 1])
-            ra = wrap_rad(np.radians(self.meas[self.i, 0] - ba) - tl[:, 0])
+            m = self.meas[self.i]
+            ra = _censored(tl[:, 0] + math.radians(ba), m[:, 0], self.step_rad, True)
             if self.robot.vehicle == "clapper":
-                rb = wrap_rad(np.radians(self.meas[self.i, 1] - bb) - tl[:, 1])
-                rl = self.meas[self.i, 2] - bl - tl[:, 2]
+                rb = _censored(tl[:, 1] + math.radians(bb), m[:, 1], self.step_rad, True)
+                rl = _censored(tl[:, 2] + bl, m[:, 2], self.step_l_mm, False)
                 cols.append(np.column_stack([ra, rb, rl]))
             else:
                 cols.append(ra[:, None])
+        return np.hstack(cols)
+
+    def anchored(self, P: dict, truck: int) -> np.ndarray:
+        """The model's pose track (at the truth's samples) placed where the truth starts.
+
+        The start pose is the mean offset of the truth from the model over the first
+        ANCHOR_S: a single motion-capture sample puts its 3e-4 rad of heading noise into every
+        later position (2 mm after 7 m), more than the noise floor the gap is judged against."""
+        p = dead_reckon(self.pr, P, truck)
+        m = np.column_stack([np.interp(self.tt, self.pr.t, p[:, k]) for k in range(3)])
+        tp = self.tpose[:, truck]
+        k = self.tt <= self.tt[0] + ANCHOR_S
+        th0 = float(np.mean(tp[k, 2] - m[k, 2]))
+        c, s_ = math.cos(th0), math.sin(th0)
+        x = c * m[:, 0] - s_ * m[:, 1]
+        y = s_ * m[:, 0] + c * m[:, 1]
+        x0 = float(np.mean(tp[k, 0] - x[k]))
+        y0 = float(np.mean(tp[k, 1] - y[k]))
+        return np.column_stack([x + x0, y + y0, m[:, 2] + th0])
+
+    def sys_z(self, P: dict, sigma: np.ndarray) -> np.ndarray:
+        """Standardised residuals for the systematic gap (diagnose._sysgap): the accumulated
+        position error of each truck along the run (model started at the truth's first pose;
+        sampled once per window, in units of the truth's position noise, sigma of a window's
+        longitudinal increment / sqrt 2), and the linkage readings against the true linkage.
+        Accumulated, because that is the gap a user sees; the windowed increments the fit uses
+        are local on purpose (an honest likelihood) and so sit close to the noise per window."""
+        cols = []
+        for t in range(self.trucks):
+            m = self.anchored(P, t)[self.i, :2]
+            cols.append((m - self.tpose[self.i, t, :2]) / (sigma[3 * t] / math.sqrt(2)))
+        if self.has_link:
+            k = 3 * self.trucks
+            cols.append(self.residuals(P)[:, k:] / sigma[k:])
         return np.hstack(cols)
 
     def extra_var(self, P: dict) -> np.ndarray | None:
@@ -121,36 +170,29 @@ class TruthMode:
             return None
         sp = P.get("roughness.spacing_mm", 20.0)
         out = np.zeros((self.i.size, len(self.channels())))
+        # the mean grain is in the model (floor_travel), so a window's residual varies by the
+        # grains' central moment, m2 - m1^2 (m2 alone overstated it ~2.8x for uniform heights and
+        # left a mean shortfall an es had to make up), plus the grain count's own spread: gaps
+        # spacing * (1 + jitter U(-1, 1)) give a renewal count of variance n cv^2, cv^2 = j^2 / 3
+        cv2 = P.get("roughness.jitter", 0.5) ** 2 / 3.0
         for t in range(self.trucks):
-            _, m2 = rough_moments(self.pr.R[t], h)
+            m1, m2 = rough_moments(self.pr.R[t], h)
+            var = m2 - m1 * m1 + cv2 * m1 * m1
             n = (self.wtravel[t, 0] + self.wtravel[t, 1]) / sp
-            out[:, 3 * t] = n * m2 / 4.0
-            out[:, 3 * t + 2] = n * m2 / self.pr.b[t] ** 2
+            out[:, 3 * t] = n * var / 4.0
+            out[:, 3 * t + 2] = n * var / self.pr.b[t] ** 2
         return out
 
     def stationary(self) -> np.ndarray:
         return np.all(self.wtravel.reshape(-1, self.i.size) < 1e-9, axis=0)
 
     def gap(self, P: dict) -> float:
-        """RMS position error (mm) of truck A along the run, model started at the truth's pose."""
-        p = dead_reckon(
-            self.pr,
-            P,
-            0,
-            tuple(np.interp(self.pr.t[0], self.tt, self.tpose[:, 0, k]) for k in range(3)),
-        )
-        m = np.column_stack([np.interp(self.tt, self.pr.t, p[:, k]) for k in range(2)])
-        return float(np.sqrt(np.mean(np.sum((m - self.tpose[:, 0, :2]) ** 2, axis=1))))
+        """RMS position error (mm) of truck A along the run, model anchored at the truth's start."""
+        m = self.anchored(P, 0)
+        return float(np.sqrt(np.mean(np.sum((m[:, :2] - self.tpose[:, 0, :2]) ** 2, axis=1))))
 
     def error_track(self, P: dict) -> tuple[np.ndarray, np.ndarray]:
-        p = dead_reckon(
-            self.pr,
-            P,
-            0,
-            tuple(np.interp(self.pr.t[0], self.tt, self.tpose[:, 0, k]) for k in range(3)),
-        )
-        m = np.column_stack([np.interp(self.tt, self.pr.t, p[:, k]) for k in range(3)])
-        return self.tt, m - self.tpose[:, 0, :]
+        return self.tt, self.anchored(P, 0) - self.tpose[:, 0, :]
 
 
 class ReturnsMode:
@@ -196,6 +238,54 @@ class LinkageMode:
         self.b = np.radians(lg.beta_deg) + half
         res = robot.linkage.get("linear_resolution_mm", 0.1)
         self.l = lg.l_mm + 0.5 * res if lg.l_mm is not None else None
+        self.steps = (2 * half, 2 * half, res)
+        q = self.q_rad
+        self.floor = np.array([q, q, res / math.sqrt(12)] if self.clapper else [q, 0.05, 0.05])
+        self.J = self._start_jac()
+        self.nuisance_per_window = self.J.shape[2]
+
+    def _start_jac(self) -> np.ndarray:
+        """(nwin, 3 channels, n start readings): how each window's prediction moves with the
+        start state (central differences of the nominal model)."""
+        names = ("a", "b", "l") if self.clapper else ("a",)
+        cols = []
+        for nm, st in zip(names, self.steps, strict=False):
+            arr = getattr(self, nm)
+            h = 0.25 * st
+            setattr(self, nm, arr + h)
+            up = self._pred({})
+            setattr(self, nm, arr - h)
+            dn = self._pred({})
+            setattr(self, nm, arr)
+            cols.append((up - dn) / (2 * h))
+        return np.stack(cols, axis=2)
+
+    def _profile(self, r: np.ndarray) -> np.ndarray:
+        """Residuals with each window's start state profiled out inside its encoder cells.
+
+        The start (alpha, beta, l) is only known to lie in the cell [code, code + step) of each
+        reading. Its true place in the cell is a nuisance: per window it is chosen to minimise the
+        weighted residual (first order, box-constrained). Taking the cell centre instead is
+        biased whenever the linkage rests (a straight clapper or trailer reads code 0 at exactly
+        0: half a step of error, on every window, always the same sign), and on the spot turns
+        carry a 0.35 deg start error into ~1 mm of predicted l, 70 linear encoder steps: that was
+        the clapper/set false alarm. Costs one parameter per reading per window (see
+        `nuisance_per_window`)."""
+        J = self.J
+        w = 1.0 / self.floor
+        Jw = J * w[None, :, None]
+        rw = r * w[None, :]
+        half = 0.5 * np.array(self.steps[: J.shape[2]])
+        A = np.einsum("nci,ncj->nij", Jw, Jw)
+        A = A + (1e-9 * np.trace(A, axis1=1, axis2=2) + 1e-9)[:, None, None] * np.eye(A.shape[1])
+        g = -np.einsum("nci,nc->ni", Jw, rw)
+        d = np.clip(np.linalg.solve(A, g[..., None])[..., 0], -half, half)
+        for _ in range(2):  # coordinate passes for the box (the clipped Newton step is close)
+            for k in range(J.shape[2]):
+                rest = rw + np.einsum("nci,ni->nc", Jw, d) - Jw[:, :, k] * d[:, k : k + 1]
+                num = -np.einsum("nc,nc->n", Jw[:, :, k], rest)
+                d[:, k] = np.clip(num / np.maximum(A[:, k, k], 1e-30), -half[k], half[k])
+        return r + np.einsum("nci,ni->nc", J, d)
 
     def channels(self) -> list[str]:
         return (
@@ -250,7 +340,7 @@ class LinkageMode:
         )
 
     def residuals(self, P: dict) -> np.ndarray:
-        return self._pred(P)
+        return self._profile(self._pred(P))
 
     def extra_var(self, P: dict) -> None:
         return None
