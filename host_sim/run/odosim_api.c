@@ -97,6 +97,33 @@ static void collect(void *user, const sim_tick_t *tk)
     c->n++;
 }
 
+/// The run's return errors as the C API reports them.
+static void fill_result(odosim_result_t *result, const sim_return_t *ret, size_t n_ticks)
+{
+    memset(result, 0, sizeof *result);
+    result->x_abs_mm = ret->x_abs_mm;
+    result->y_abs_mm = ret->y_abs_mm;
+    result->theta_abs_deg = ret->theta_abs_deg;
+    result->x_calc_mm = ret->x_calc_mm;
+    result->y_calc_mm = ret->y_calc_mm;
+    result->theta_calc_deg = ret->theta_calc_deg;
+    result->ex_mm = ret->ex_mm;
+    result->ey_mm = ret->ey_mm;
+    result->etheta_deg = ret->etheta_deg;
+    result->t_end_s = ret->t_end_s;
+    result->n_ticks = n_ticks;
+}
+
+/// ipec: 0 off, 1 the paper's per-tick form, 2 the sub-resolution estimator (sil.h).
+static int check_ipec(int ipec, char *err, size_t errlen)
+{
+    if (ipec < 0 || ipec > 2) {
+        snprintf(err, errlen, "ipec must be 0 (off), 1 (paper) or 2 (estimator), not %d", ipec);
+        return -1;
+    }
+    return 0;
+}
+
 int odosim_run(const odosim_setup_t *s, const char *experiment, int ccw, int bumps, int ipec, uint64_t seed,
                unsigned run_index, odosim_tick_row_t *rows, size_t capacity, odosim_result_t *result,
                char *err, size_t errlen)
@@ -105,26 +132,18 @@ int odosim_run(const odosim_setup_t *s, const char *experiment, int ccw, int bum
         snprintf(err, errlen, "NULL argument");
         return -1;
     }
+    if (check_ipec(ipec, err, errlen) != 0) {
+        return -1;
+    }
     const sim_run_config_t cfg = {.robot = &s->robot, .scenario = &s->scenario, .experiment = experiment,
                                   .ccw = ccw ? 1 : 0, .bumps = bumps, .bump_height_mm = 10.0,
-                                  .ipec = ipec ? 1 : 0, .seed = seed, .run_index = run_index};
+                                  .ipec = ipec, .seed = seed, .run_index = run_index};
     collect_t c = {rows, capacity, 0};
     sim_return_t ret;
     if (sim_run(&cfg, collect, &c, &ret, err, errlen) != 0) {
         return -1;
     }
-    memset(result, 0, sizeof *result);
-    result->x_abs_mm = ret.x_abs_mm;
-    result->y_abs_mm = ret.y_abs_mm;
-    result->theta_abs_deg = ret.theta_abs_deg;
-    result->x_calc_mm = ret.x_calc_mm;
-    result->y_calc_mm = ret.y_calc_mm;
-    result->theta_calc_deg = ret.theta_calc_deg;
-    result->ex_mm = ret.ex_mm;
-    result->ey_mm = ret.ey_mm;
-    result->etheta_deg = ret.etheta_deg;
-    result->t_end_s = ret.t_end_s;
-    result->n_ticks = c.n;
+    fill_result(result, &ret, c.n);
     return 0;
 }
 
@@ -186,30 +205,22 @@ int odosim_run_ex(const odosim_setup_t *s, const odosim_run_opts_t *o, odosim_ti
         snprintf(err, errlen, "NULL argument");
         return -1;
     }
+    if (check_ipec(o->ipec, err, errlen) != 0) {
+        return -1;
+    }
     const sim_hidden_t hidden = {o->motor_tau_s, o->diam_var_amp, o->diam_var_period_s, o->diam_drift_per_s,
                                  o->backlash_rad};
     const sim_run_config_t cfg = {.robot = &s->robot, .scenario = &s->scenario, .experiment = o->experiment,
                                   .ccw = o->ccw ? 1 : 0, .bumps = o->bumps,
                                   .bump_height_mm = o->bump_height_mm > 0.0 ? o->bump_height_mm : 10.0,
-                                  .ipec = o->ipec ? 1 : 0, .seed = o->seed, .run_index = o->run_index,
+                                  .ipec = o->ipec, .seed = o->seed, .run_index = o->run_index,
                                   .physics_dt_s = o->physics_dt_s, .hidden = &hidden};
     collect_ex_t c = {rows, capacity, 0, events, ev_capacity, 0};
     sim_return_t ret;
     if (sim_run(&cfg, collect_ex, &c, &ret, err, errlen) != 0) {
         return -1;
     }
-    memset(result, 0, sizeof *result);
-    result->x_abs_mm = ret.x_abs_mm;
-    result->y_abs_mm = ret.y_abs_mm;
-    result->theta_abs_deg = ret.theta_abs_deg;
-    result->x_calc_mm = ret.x_calc_mm;
-    result->y_calc_mm = ret.y_calc_mm;
-    result->theta_calc_deg = ret.theta_calc_deg;
-    result->ex_mm = ret.ex_mm;
-    result->ey_mm = ret.ey_mm;
-    result->etheta_deg = ret.etheta_deg;
-    result->t_end_s = ret.t_end_s;
-    result->n_ticks = c.n;
+    fill_result(result, &ret, c.n);
     if (n_events != NULL) {
         *n_events = c.n_ev;
     }

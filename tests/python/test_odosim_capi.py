@@ -92,6 +92,8 @@ def test_candidate_effects_are_set_in_memory_and_errors_are_reported(lib: C.CDLL
     assert lib.odosim_setup_set(s, b"ed", b"value", 1, 9.0, err, 512) != 0
     assert lib.odosim_run(s, b"figure-8", 0, -1, 0, 1, 0, None, 0, C.byref(base), err, 512) != 0
     assert b"figure-8" in err.value
+    assert lib.odosim_run(s, b"umbmark", 0, -1, 3, 1, 0, None, 0, C.byref(base), err, 512) != 0
+    assert b"ipec" in err.value
     lib.odosim_setup_free(s)
 
 

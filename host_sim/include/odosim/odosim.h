@@ -66,7 +66,8 @@ void odosim_setup_free(odosim_setup_t *s);
 uint64_t odosim_run_seed(uint64_t base_seed, int ccw, unsigned run);
 
 /// One run of an experiment ("umbmark", "umbmark-ext", "straight-36m", "rect-7x4"); bumps < 0 for
-/// the experiment's default; ipec 0/1. Writes up to `capacity` rows (rows may be NULL). Returns 0.
+/// the experiment's default; ipec 0 off, 1 paper form, 2 estimator (else -1). Writes up to
+/// `capacity` rows (rows may be NULL). Returns 0.
 int odosim_run(const odosim_setup_t *s, const char *experiment, int ccw, int bumps, int ipec,
                uint64_t seed, unsigned run_index, odosim_tick_row_t *rows, size_t capacity,
                odosim_result_t *result, char *err, size_t errlen);
