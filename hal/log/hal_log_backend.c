@@ -17,21 +17,7 @@ int hal_log_backend_open(hal_ctx_t *ctx, const char *path, FILE *tx, const char 
 
 void hal_log_backend_close(hal_ctx_t *ctx) { hal_log_close(&ctx->log); }
 
-bool hal_wheel_read(hal_ctx_t *ctx, uint8_t truck, odo_wheel_input_t *out)
-{
-    (void)ctx;
-    (void)truck;
-    out->present = false;
-    return false;
-}
-
-bool hal_link_read(hal_ctx_t *ctx, odo_link_input_t *out)
-{
-    (void)ctx;
-    out->rotary_present = false;
-    out->linear_present = false;
-    return false;
-}
+/* hal_wheel_read, hal_link_read: hal/hal_frames_only.c (sensors arrive as frames). */
 
 bool hal_can_send(hal_ctx_t *ctx, const odo_can_frame_t *frame)
 {

@@ -1,21 +1,7 @@
 /// hal_socketcan behind hal/hal.h (see hal_socketcan_backend.h).
 #include "hal_socketcan_backend.h"
 
-bool hal_wheel_read(hal_ctx_t *ctx, uint8_t truck, odo_wheel_input_t *out)
-{
-    (void)ctx;
-    (void)truck;
-    out->present = false;
-    return false;
-}
-
-bool hal_link_read(hal_ctx_t *ctx, odo_link_input_t *out)
-{
-    (void)ctx;
-    out->rotary_present = false;
-    out->linear_present = false;
-    return false;
-}
+/* hal_wheel_read, hal_link_read: hal/hal_frames_only.c (sensors arrive as frames). */
 
 bool hal_can_send(hal_ctx_t *ctx, const odo_can_frame_t *frame) { return hal_socketcan_send(&ctx->sc, frame); }
 

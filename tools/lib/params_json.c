@@ -256,16 +256,12 @@ int odo_params_file_load(const char *path, odo_params_t *p, char *err, size_t er
     return rc;
 }
 
-int odo_params_json_write(FILE *f, const odo_params_t *p)
+void odo_params_json_fields(FILE *f, const odo_params_t *p)
 {
-    uint8_t block[ODO_PARAMS_SIZE];
-    (void)odo_params_encode(p, block, sizeof block);
-    fprintf(f,
-            "{\"status\": \"ok\", \"magic\": \"ODOP\", \"version\": %u, \"length\": %u, \"crc32\": \"0x%08" PRIX32
-            "\",\n \"vehicle\": %u, \"counter_bits\": %u, \"heading_form\": %u, \"ipec_mode\": %u, \"tick_us\": %" PRIu32
-            ", \"max_wheel_speed_mm_s\": %" PRIu32 ",\n \"truck\": [",
-            ODO_PARAMS_VERSION, ODO_PARAMS_SIZE, odo_crc32(block, ODO_PARAMS_CRC_OFFSET), p->vehicle,
-            p->counter_bits, p->heading_form, p->ipec_mode, p->tick_us, p->max_wheel_speed_mm_s);
+    fprintf(f, " \"vehicle\": %u, \"counter_bits\": %u, \"heading_form\": %u, \"ipec_mode\": %u, "
+               "\"tick_us\": %" PRIu32 ", \"max_wheel_speed_mm_s\": %" PRIu32 ",\n \"truck\": [",
+            p->vehicle, p->counter_bits, p->heading_form, p->ipec_mode, p->tick_us,
+            p->max_wheel_speed_mm_s);
     for (unsigned t = 0; t < ODO_TRUCKS; t++) {
         const odo_truck_params_t *tr = &p->truck[t];
         fprintf(f,
@@ -281,9 +277,20 @@ int odo_params_json_write(FILE *f, const odo_params_t *p)
                ", \"alpha_bias_bam\": %" PRId32 ", \"beta_bias_bam\": %" PRId32
                ", \"rotary_bits\": %u, \"stale_ticks\": %u, \"max_jump_bam\": %" PRIu32
                ", \"max_length_jump_um\": %" PRIu32 ", \"length_min_um\": %" PRIu32
-               ", \"length_max_um\": %" PRIu32 "}}\n",
+               ", \"length_max_um\": %" PRIu32 "}",
             l->length_nm, l->hitch_offset_nm, l->length_bias_nm, l->length_ecc_nm, l->alpha_bias_bam,
             l->beta_bias_bam, l->rotary_bits, l->stale_ticks, l->max_jump_bam, l->max_length_jump_um,
             l->length_min_um, l->length_max_um);
+}
+
+int odo_params_json_write(FILE *f, const odo_params_t *p)
+{
+    uint8_t block[ODO_PARAMS_SIZE];
+    (void)odo_params_encode(p, block, sizeof block);
+    fprintf(f, "{\"status\": \"ok\", \"magic\": \"ODOP\", \"version\": %u, \"length\": %u, "
+               "\"crc32\": \"0x%08" PRIX32 "\",\n",
+            ODO_PARAMS_VERSION, ODO_PARAMS_SIZE, odo_crc32(block, ODO_PARAMS_CRC_OFFSET));
+    odo_params_json_fields(f, p);
+    fputs("}\n", f);
     return ferror(f) ? -1 : 0;
 }

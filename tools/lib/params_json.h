@@ -38,6 +38,10 @@ int odo_params_file_load(const char *path, odo_params_t *p, char *err, size_t er
 
 /// Write *p in the shape above (with "status", "magic", "version", "length", and the "crc32" of
 /// its encoding). Returns 0, or -1 on an I/O error.
+/// The block's fields as JSON object members (from "vehicle" to the "link" object, no braces and
+/// no trailing newline): the part `odo-params show` and odo_params_json_write share.
+void odo_params_json_fields(FILE *f, const odo_params_t *p);
+
 int odo_params_json_write(FILE *f, const odo_params_t *p);
 
 #endif

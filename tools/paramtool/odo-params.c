@@ -19,6 +19,7 @@
 #include <unistd.h>
 
 #include "odo/odo_params.h"
+#include "params_json.h"
 
 #define EXIT_REJECTED 1
 #define EXIT_USAGE    2
@@ -262,30 +263,8 @@ static void print_json(FILE *f, const char *path, const uint8_t *b, const odo_pa
     fprintf(f, ", \"status\": \"ok\", \"magic\": \"ODOP\", \"version\": %u, \"length\": %u, "
                "\"crc32\": \"0x%08" PRIX32 "\",\n",
             (unsigned)le16(&b[4]), (unsigned)le16(&b[6]), le32(&b[ODO_PARAMS_CRC_OFFSET]));
-    fprintf(f, " \"vehicle\": %u, \"counter_bits\": %u, \"heading_form\": %u, \"ipec_mode\": %u, "
-               "\"tick_us\": %" PRIu32 ", \"max_wheel_speed_mm_s\": %" PRIu32 ",\n",
-            p->vehicle, p->counter_bits, p->heading_form, p->ipec_mode, p->tick_us,
-            p->max_wheel_speed_mm_s);
-    fprintf(f, " \"truck\": [");
-    for (unsigned t = 0; t < ODO_TRUCKS; t++) {
-        const odo_truck_params_t *tr = &p->truck[t];
-        fprintf(f,
-                "%s\n  {\"wheel_diameter_nm\": %" PRIu32 ", \"counts_per_rev_milli\": %" PRIu32
-                ", \"wheelbase_nm\": %" PRIu32 ", \"ed_q30\": %" PRId32 ", \"eb_q30\": %" PRId32
-                ", \"es_q30\": %" PRId32 ", \"flags\": %u}",
-                t == 0 ? "" : ",", tr->wheel_diameter_nm, tr->counts_per_rev_milli, tr->wheelbase_nm,
-                tr->ed_q30, tr->eb_q30, tr->es_q30, tr->flags);
-    }
-    const odo_link_params_t *l = &p->link;
-    fprintf(f, "],\n \"link\": {\"length_nm\": %" PRIu32 ", \"hitch_offset_nm\": %" PRIu32
-               ", \"length_bias_nm\": %" PRId32 ", \"length_ecc_nm\": %" PRId32
-               ", \"alpha_bias_bam\": %" PRId32 ", \"beta_bias_bam\": %" PRId32
-               ", \"rotary_bits\": %u, \"stale_ticks\": %u, \"max_jump_bam\": %" PRIu32
-               ", \"max_length_jump_um\": %" PRIu32 ", \"length_min_um\": %" PRIu32
-               ", \"length_max_um\": %" PRIu32 "}}\n",
-            l->length_nm, l->hitch_offset_nm, l->length_bias_nm, l->length_ecc_nm, l->alpha_bias_bam,
-            l->beta_bias_bam, l->rotary_bits, l->stale_ticks, l->max_jump_bam, l->max_length_jump_um,
-            l->length_min_um, l->length_max_um);
+    odo_params_json_fields(f, p);
+    fputs("}\n", f);
 }
 
 /// Explain a rejected block: detail[] gets the specifics, field[] the offending field (range only).
