@@ -94,3 +94,66 @@ def test_a_no_effect_two_truck_vehicle_is_no_significant_gap(vehicle: str, tmp_p
         v = rep["verdict"]
         assert v["effect"] == "rotary_bias", (mode, v)
         assert v["params"]["rotary_bias.alpha_deg"] == pytest.approx(-1.3, abs=0.1)
+
+
+def _two_trucks(ds_a: np.ndarray, ds_b: np.ndarray, link=None, driven=(True, True)):
+    from odo_tools.gap.model import Prepared
+
+    ds = np.stack([ds_a, ds_b], axis=1)  # (n-1, 2 trucks, 2 wheels)
+    n = ds.shape[0] + 1
+    S = np.concatenate([np.zeros((1, 2, 2)), np.cumsum(np.abs(ds), axis=0)])
+    return Prepared(
+        None, np.arange(n) * 0.04, ds, S, [340.0, 340.0], [75.0, 75.0], np.full(n - 1, 0.04),
+        driven=list(driven), link=link,
+    )  # fmt: skip
+
+
+def test_clapper_link_clamp_pushes_both_trucks_half_way() -> None:
+    """world.c clamp_link: A drives 300 mm away from a standing B on a 1000 mm link with range
+    [900, 1100]; the 200 mm beyond the range are taken up half by each truck."""
+    from odo_tools.gap.model import dead_reckon
+
+    a = np.full((30, 2), 10.0)
+    pr = _two_trucks(a, np.zeros((30, 2)), link=(1000.0, 0.0, 0.0, 900.0, 1100.0, None))
+    pa, pb = dead_reckon(pr, {}, 0), dead_reckon(pr, {}, 1)
+    assert pa[-1, 0] == pytest.approx(200.0, abs=1e-9) and pb[-1, 0] == pytest.approx(100.0)
+    assert np.allclose(pa[:, 1], 0.0) and np.allclose(pb[:, 2], 0.0)
+    # inside the range nothing moves the trucks but their wheels
+    pr = _two_trucks(a[:5], np.zeros((5, 2)), link=(1000.0, 0.0, 0.0, 900.0, 1100.0, None))
+    assert dead_reckon(pr, {}, 0)[-1, 0] == pytest.approx(50.0) and np.allclose(
+        dead_reckon(pr, {}, 1), 0.0
+    )
+    # a reading that is not at the range's end (gate) forbids the clamp
+    gate = np.zeros(31, dtype=bool)
+    pr = _two_trucks(a, np.zeros((30, 2)), link=(1000.0, 0.0, 0.0, 900.0, 1100.0, gate))
+    assert dead_reckon(pr, {}, 0)[-1, 0] == pytest.approx(300.0)
+
+
+def test_drive_effects_do_not_act_on_a_passive_trailer() -> None:
+    """world.c: slip and skid live in step_driven; a set's trailer rolls passively."""
+    from odo_tools.gap.model import floor_travel
+
+    v = np.concatenate([np.zeros(5), np.full(20, 20.0), np.zeros(5)])
+    w = np.column_stack([v, 1.05 * v])
+    P = {"slip.k_per_m_s2": 1.0, "skid.k_s": 0.3, "skid.a0_m_s2": 0.0}
+    pr = _two_trucks(w, w, driven=(True, False))
+    da, _, la = floor_travel(pr, P, 0)
+    db, _, lb = floor_travel(pr, P, 1)
+    assert not np.allclose(da, w) and np.abs(la).max() > 0  # the driven truck slips and skids
+    assert np.allclose(db, w) and np.allclose(lb, 0.0)
+
+
+def test_roughness_window_share_matches_a_direct_count() -> None:
+    """A grain of horizontal span s, its excess spread evenly over it, at a uniform phase: the
+    share f a window of L mm sees has E[f^2] L = L - s/3 (s <= L); counted here directly."""
+    from odo_tools.gap.model import rough_window_var
+
+    R, h = 75.0, 3.0
+    s = 2.0 * math.sqrt(2 * R * h - h * h)
+    for L in (120.0, 0.5 * s):
+        u = np.linspace(-s, L, 200001)  # grain start relative to the window's start
+        f = (np.clip(u + s, 0.0, L) - np.clip(u, 0.0, L)) / s
+        direct = np.trapezoid(f * f, u) / L
+        # one height: hmax tiny band around h via n=1 (midpoint of [0, hmax] = h)
+        _, _, q = rough_window_var(R, 2 * h, np.array([L]), n=1)
+        assert q[0] == pytest.approx(direct, rel=1e-3)

@@ -147,6 +147,18 @@ def read_robot(path: str | Path) -> Robot:
             "rotary_bits": int(lk.get("rotary_bits", 10)),
             "linear_resolution_mm": float(lk.get("linear_resolution_mm", 0.1)),
         }
+        rg = lk.get("range_mm")  # mechanical range of l (robot.c default: length +- 100 mm)
+        L = r.linkage["length_mm"]
+        if rg is None:
+            rg = [L - 100.0, L + 100.0]
+        if (
+            not isinstance(rg, list)
+            or len(rg) != 2
+            or not all(isinstance(v, (int, float)) for v in rg)
+            or not rg[0] < L < rg[1]
+        ):
+            raise GapInputError(path, "linkage.range_mm: expected [min, max] around length_mm")
+        r.linkage["range_mm"] = (float(rg[0]), float(rg[1]))
     if r.vehicle == "set":
         tr = raw.get("trailer")
         if not isinstance(tr, dict):

@@ -29,6 +29,10 @@ class Prepared:
     R: list[float]
     dt: np.ndarray  # (n-1,)
     bumps: list[dict] = field(default_factory=list)  # events placed by the bump hypothesis
+    # trucks whose wheels are driven (world.c `driven`: A, and B of a clapper); a set's trailer
+    # rolls passively, so the drive effects (slip, skid: world.c step_driven) never act on it
+    driven: list[bool] = field(default_factory=lambda: [True, True])
+    link: tuple | None = None  # clapper: (l0, alpha0, beta0, l_min, l_max, at_limit) (mm, rad)
 
 
 def prepare(run: RunData, robot: Robot) -> Prepared:
@@ -53,7 +57,35 @@ def prepare(run: RunData, robot: Robot) -> Prepared:
         [robot.trucks[t]["wheelbase_mm"] for t in range(T)],
         [0.5 * robot.trucks[t]["wheel_diameter_mm"] for t in range(T)],
         np.diff(run.log.t_s),
+        driven=[t == 0 or robot.vehicle == "clapper" for t in range(T)],
+        link=_link_start(run, robot),
     )
+
+
+def _link_start(run: RunData, robot: Robot) -> tuple | None:
+    """A clapper's start geometry (its first linkage readings, else straight at its length) and
+    the mechanical range of l."""
+    if robot.vehicle != "clapper":
+        return None
+    lg = run.log
+    lo, hi = robot.linkage["range_mm"]
+    l0 = robot.linkage["length_mm"]
+    a0 = b0 = 0.0
+    if lg.l_mm is not None and np.isfinite(lg.l_mm[0]):
+        l0 = float(lg.l_mm[0])
+    if lg.alpha_deg is not None and np.isfinite(lg.alpha_deg[0]):
+        a0 = math.radians(float(lg.alpha_deg[0]))
+    if lg.beta_deg is not None and np.isfinite(lg.beta_deg[0]):
+        b0 = math.radians(float(lg.beta_deg[0]))
+    # ticks whose l reading sits at the range's ends (within 1 mm): the clamp is only replayed
+    # there, so a start geometry a biased reading misplaces cannot clamp where the robot did not
+    gate = None
+    if lg.l_mm is not None:
+        gate = (lg.l_mm <= lo + LIMIT_TOL_MM) | (lg.l_mm >= hi - LIMIT_TOL_MM)
+    return (l0, a0, b0, lo, hi, gate)
+
+
+LIMIT_TOL_MM = 1.0
 
 
 # ------------------------------------------------------------------------------------------------
@@ -102,6 +134,21 @@ def rough_moments(R: float, hmax: float, n: int = 64) -> tuple[float, float]:
     return float(dd.mean()), float((dd * dd).mean())
 
 
+def rough_window_var(R: float, hmax: float, L: np.ndarray, n: int = 32) -> tuple:
+    """Per-grain E[dd^2 q] and E[q] over heights uniform in [0, hmax] for windows of L mm of travel.
+
+    A grain spreads its excess over its horizontal span s = 2 sqrt(2 R h - h^2); a window cuts the
+    grains at its ends, so of a grain starting at a uniform phase it sees the fraction f, and
+    E[f^2] L = L - s / 3 (s <= L) or L^2 (s - L / 3) / s^2 (s > L). q = E[f^2] (per grain and
+    window: the window's variance is lambda L E[dd^2 q] instead of lambda L E[dd^2])."""
+    u = (np.arange(n) + 0.5) / n * hmax
+    dd = bump_dd(R, u)
+    s = 2.0 * np.sqrt(np.maximum(2 * R * u - u * u, 0.0))  # (n,)
+    Lc = np.maximum(np.asarray(L, dtype=float), 1e-9)[:, None]
+    q = np.where(s <= Lc, 1.0 - s / (3.0 * Lc), Lc * (s - Lc / 3.0) / np.maximum(s, 1e-12) ** 2)
+    return (dd * dd * q).mean(axis=1), (dd * q).mean(axis=1), q.mean(axis=1)
+
+
 def floor_travel(pr: Prepared, P: dict, truck: int) -> tuple[np.ndarray, float, np.ndarray]:
     """(n-1, 2) floor travel per tick, true wheelbase, (n-1,) lateral skid per tick (mm)."""
     ds = pr.ds[:, truck, :].copy()
@@ -112,8 +159,11 @@ def floor_travel(pr: Prepared, P: dict, truck: int) -> tuple[np.ndarray, float, 
     hr = P.get("roughness.max_height_mm", 0.0)
     if hr > 0:
         m1, _ = rough_moments(R, hr)
-        ds *= 1.0 - m1 / P.get("roughness.spacing_mm", 20.0)
-    k = P.get("slip.k_per_m_s2", 0.0)
+        # grains are laid per mm of the wheel's horizontal progress (world.c reach_bumps advances
+        # the odometer by `hor`): rotation = floor (1 + m1 / spacing), not floor = rotation (1 - ..)
+        ds /= 1.0 + m1 / P.get("roughness.spacing_mm", 20.0)
+    drive = pr.driven[truck]
+    k = P.get("slip.k_per_m_s2", 0.0) if drive else 0.0
     if k > 0:
         ds += slip_loss(pr, P, truck, k)
     for ev in pr.bumps:
@@ -125,7 +175,7 @@ def floor_travel(pr: Prepared, P: dict, truck: int) -> tuple[np.ndarray, float, 
         ds[:, w] -= np.sign(pr.ds[:, truck, w]) * np.diff(e)
     bt = b * P.get("eb.value", 1.0)
     lat = np.zeros(ds.shape[0])
-    ks = P.get("skid.k_s", 0.0)
+    ks = P.get("skid.k_s", 0.0) if drive else 0.0
     if ks > 0:
         v = 0.5 * (ds[:, 0] + ds[:, 1]) / pr.dt
         om = (ds[:, 1] - ds[:, 0]) / bt / pr.dt
@@ -191,7 +241,70 @@ def integrate(ds: np.ndarray, b: float, lat: np.ndarray, pose0=(0.0, 0.0, 0.0)) 
 
 def dead_reckon(pr: Prepared, P: dict, truck: int = 0, pose0=(0.0, 0.0, 0.0)) -> np.ndarray:
     ds, bt, lat = floor_travel(pr, P, truck)
-    return integrate(ds, bt, lat, pose0)
+    p = integrate(ds, bt, lat, pose0)
+    if pr.link is None or len(pr.R) < 2:
+        return p
+    return _clamp_link(pr, p, integrate(*floor_travel(pr, P, 1 - truck)), truck, pose0)
+
+
+def _clamp_link(pr: Prepared, p: np.ndarray, q: np.ndarray, truck: int, pose0) -> np.ndarray:
+    """A clapper's l stays within its mechanical range: world.c clamp_link pushes both trucks
+    equally along the link when it would leave it (motion the wheels never see, e.g. when slip
+    lets the trucks drift 100 mm apart on rect-7x4). Tracks that never leave the range come back
+    unchanged; otherwise the clamp is replayed per tick from the first violation. `p` is
+    `truck`'s track (from pose0), `q` the other truck's (from the origin)."""
+    l0, a0, b0, lo, hi, gate = pr.link
+    th_link = -a0  # A at the origin, heading 0; alpha = A's heading - the link's
+    B0 = (-l0 * math.cos(th_link), -l0 * math.sin(th_link), th_link + b0)
+    A0 = (0.0, 0.0, 0.0)
+
+    def place(tr: np.ndarray, start: tuple, at: tuple) -> np.ndarray:
+        # rigid move of a track that started at `start` so that it starts at `at`
+        d = at[2] - start[2]
+        c, s_ = math.cos(d), math.sin(d)
+        x, y = tr[:, 0] - start[0], tr[:, 1] - start[1]
+        return np.column_stack([at[0] + c * x - s_ * y, at[1] + s_ * x + c * y, tr[:, 2] + d])
+
+    p0 = tuple(pose0)
+    pa = place(p, p0, A0) if truck == 0 else place(q, A0, A0)
+    pb = place(q, A0, B0) if truck == 0 else place(p, p0, B0)
+    ln = np.hypot(pa[:, 0] - pb[:, 0], pa[:, 1] - pb[:, 1])
+    out_of = (ln < lo) | (ln > hi)
+    if gate is not None:
+        out_of &= gate[: ln.size]
+    bad = np.flatnonzero(out_of)
+    if bad.size == 0:
+        return p
+    i0 = max(int(bad[0]), 1)
+    da, db = np.diff(pa[:, :2], axis=0), np.diff(pb[:, :2], axis=0)
+    xa, ya = float(pa[i0 - 1, 0]), float(pa[i0 - 1, 1])
+    xb, yb = float(pb[i0 - 1, 0]), float(pb[i0 - 1, 1])
+    push = np.zeros((pa.shape[0], 2))  # cumulative push of truck A (B: the opposite)
+    ox = oy = 0.0
+    for i in range(i0, pa.shape[0]):
+        xa += da[i - 1, 0]
+        ya += da[i - 1, 1]
+        xb += db[i - 1, 0]
+        yb += db[i - 1, 1]
+        dx, dy = xa - xb, ya - yb
+        li = math.hypot(dx, dy)
+        if (li < lo or li > hi) and (gate is None or gate[i]):
+            half = 0.5 * ((lo if li < lo else hi) - li)
+            ux, uy = (dx / li, dy / li) if li > 0 else (1.0, 0.0)
+            xa += half * ux
+            ya += half * uy
+            xb -= half * ux
+            yb -= half * uy
+            ox += half * ux
+            oy += half * uy
+        push[i] = (ox, oy)
+    sgn = 1.0 if truck == 0 else -1.0
+    d = p0[2] - (A0 if truck == 0 else B0)[2]  # back into the track's own frame
+    c, s_ = math.cos(d), math.sin(d)
+    out = p.copy()
+    out[:, 0] += sgn * (c * push[:, 0] - s_ * push[:, 1])
+    out[:, 1] += sgn * (s_ * push[:, 0] + c * push[:, 1])
+    return out
 
 
 def link_bias(P: dict, alpha: np.ndarray, beta: np.ndarray) -> tuple:

@@ -16,7 +16,7 @@ import math
 import numpy as np
 
 from .io import Robot
-from .model import Prepared, dead_reckon, link_bias, rough_moments, wrap_rad
+from .model import Prepared, dead_reckon, link_bias, rough_moments, rough_window_var, wrap_rad
 
 WINDOW_S = 0.4  # truth increments: window length
 HORIZON_S = 1.0  # linkage mode: prediction horizon
@@ -176,11 +176,22 @@ class TruthMode:
         # spacing * (1 + jitter U(-1, 1)) give a renewal count of variance n cv^2, cv^2 = j^2 / 3
         cv2 = P.get("roughness.jitter", 0.5) ** 2 / 3.0
         for t in range(self.trucks):
-            m1, m2 = rough_moments(self.pr.R[t], h)
-            var = m2 - m1 * m1 + cv2 * m1 * m1
-            n = (self.wtravel[t, 0] + self.wtravel[t, 1]) / sp
-            out[:, 3 * t] = n * var / 4.0
-            out[:, 3 * t + 2] = n * var / self.pr.b[t] ** 2
+            # each wheel: grains cut by the window's ends count by their share only
+            # (model.rough_window_var; without it the variance was ~20 % too high on 0.4 s
+            # windows and pulled the height down, an es making up the mean)
+            m1, _ = rough_moments(self.pr.R[t], h)
+            var = np.zeros(self.i.size)
+            for w in (0, 1):
+                L = self.wtravel[t, w]
+                e2q, _, q = rough_window_var(self.pr.R[t], h, L)
+                var += (L / sp) * (e2q - m1 * m1 * q + cv2 * m1 * m1 * q)
+            b = self.pr.b[t]
+            out[:, 3 * t] = var / 4.0
+            out[:, 3 * t + 2] = var / b**2
+            # a grain turns the truck by dd / b; the rest of the window's travel carries that
+            # turn sideways: lateral variance var / b^2 * Lt^2 / 3 (grain phase uniform)
+            Lt = 0.5 * (self.wtravel[t, 0] + self.wtravel[t, 1])
+            out[:, 3 * t + 1] = var / b**2 * Lt**2 / 3.0
         return out
 
     def stationary(self) -> np.ndarray:
