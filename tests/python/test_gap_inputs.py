@@ -97,3 +97,9 @@ def test_mode_without_its_frames(good: Path, tmp_path: Path) -> None:
     d = copy(good, tmp_path)
     (d / "returns.csv").unlink()
     fails(d, tmp_path, "mode returns needs", extra=("--mode", "returns"))
+
+
+@pytest.mark.parametrize("value", ["1", "1,0,2", "0,0.02", "-1,0.02", "1,nan", "a,b"])
+def test_bad_return_accuracy(good: Path, tmp_path: Path, value: str) -> None:
+    fails(good, tmp_path, "--return-accuracy", extra=("--mode", "returns", "--return-accuracy",
+                                                      value))

@@ -329,7 +329,9 @@ def _diag(job: tuple) -> dict:
     from .errors import GapInputError
 
     try:
-        rep = diagnose(real, Path(real) / "robot.json", 0.5, 1, mode)
+        # the instrument the returns were measured with is part of the recording, not the key
+        acc = (RETURN_NOISE_MM, RETURN_NOISE_DEG)
+        rep = diagnose(real, Path(real) / "robot.json", 0.5, 1, mode, return_accuracy=acc)
         write_report(dict(rep), Path(real).parent / f"report-{mode}")
         rep.pop("_plot", None)
         return {"real": real, "mode": mode, "report": rep}

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 import time
 
@@ -32,6 +33,13 @@ def main(argv: list[str] | None = None) -> int:
         choices=["truth", "returns", "linkage"],
         help="evidence to use (default: the richest the data has)",
     )
+    d.add_argument(
+        "--return-accuracy",
+        metavar="MM,DEG",
+        help="accuracy (one sigma) of the measured return poses, e.g. 1,0.02 for a tape and a "
+        "protractor: returns mode then judges their spread against it (roughness); without it "
+        "the spread is the noise",
+    )
     d.add_argument("--out", required=True)
     d.add_argument("--quiet", action="store_true")
     b = sub.add_parser("blind", help="the withheld-effect check: generate, diagnose, score")
@@ -45,10 +53,20 @@ def main(argv: list[str] | None = None) -> int:
         if a.cmd == "diagnose":
             if not 0.0 <= a.holdout < 1.0:
                 ap.error("--holdout must be in [0, 1)")
+            acc = None
+            if a.return_accuracy is not None:
+                try:
+                    acc = tuple(float(x) for x in a.return_accuracy.split(","))
+                except ValueError:
+                    acc = ()
+                if len(acc) != 2 or not all(math.isfinite(x) and x > 0 for x in acc):
+                    ap.error("--return-accuracy: expected MM,DEG, two positive numbers")
             from .diagnose import diagnose, write_report
 
             t0 = time.perf_counter()
-            rep = diagnose(a.real, a.robot, a.holdout, a.seed, a.mode, _progress(a.quiet))
+            rep = diagnose(
+                a.real, a.robot, a.holdout, a.seed, a.mode, _progress(a.quiet), acc
+            )
             write_report(rep, a.out)
             v = rep["verdict"]
             print(

@@ -33,6 +33,9 @@ class Prepared:
     # rolls passively, so the drive effects (slip, skid: world.c step_driven) never act on it
     driven: list[bool] = field(default_factory=lambda: [True, True])
     link: tuple | None = None  # clapper: (l0, alpha0, beta0, l_min, l_max, at_limit) (mm, rad)
+    path: str | None = None  # which path the run drove (fit.assign_paths)
+    slip_cache: dict = field(default_factory=dict, repr=False)  # slip_loss results by parameters
+    track_cache: dict = field(default_factory=dict, repr=False)  # _track results by parameters
 
 
 def prepare(run: RunData, robot: Robot) -> Prepared:
@@ -171,8 +174,15 @@ def floor_travel(pr: Prepared, P: dict, truck: int) -> tuple[np.ndarray, float, 
             continue
         w = ev["wheel"]
         S = pr.S[:, truck, w]
-        e = bump_excess(R, ev["h"], S - ev["s0"])
-        ds[:, w] -= np.sign(pr.ds[:, truck, w]) * np.diff(e)
+        # the excess only grows while the wheel's travel is inside the bump's span
+        h = min(max(ev["h"], 1e-9), 0.999 * R)
+        span = 2.0 * R * math.acos(1.0 - h / R)
+        i0 = max(int(np.searchsorted(S, ev["s0"], side="right")) - 1, 0)
+        i1 = min(int(np.searchsorted(S, ev["s0"] + span, side="left")), S.size - 1)
+        if i1 <= i0:
+            continue
+        e = bump_excess(R, ev["h"], S[i0 : i1 + 1] - ev["s0"])
+        ds[i0:i1, w] -= np.sign(pr.ds[i0:i1, truck, w]) * np.diff(e)
     bt = b * P.get("eb.value", 1.0)
     lat = np.zeros(ds.shape[0])
     ks = P.get("skid.k_s", 0.0) if drive else 0.0
@@ -186,41 +196,74 @@ def floor_travel(pr: Prepared, P: dict, truck: int) -> tuple[np.ndarray, float, 
 
 
 SLIP_SUB_S = 0.001  # sub-step of the slip integral (the catalog's law acts per physics step)
-SLIP_SUBSTEPS = 40  # one 40 ms tick: a lag of a few ms has settled long before its end
+
+
+def drive_commands(v: np.ndarray, tau: float, M: int) -> tuple[np.ndarray, np.ndarray]:
+    """The per-tick commands c and the drive's speed m at each tick's start behind the recorded
+    mean speeds v (n, ...), for a drive that follows a command held over a tick of M sub-steps
+    with a first-order lag: per sub-step speed += (c - speed) g, g = 1 - exp(-sub / tau)
+    (host_sim world.c step_driven). Over a tick the mean is v_k = (1 - f) c_k + f m_k with
+    f = mean of q^j (j = 1..M, q = 1 - g), and m_(k+1) = (1 - Q) c_k + Q m_k with Q = q^M: an LTI
+    filter from c to v, inverted exactly (the drive starts at rest). Taking v_k - v_(k-1) as the
+    command step, as before, split one step over two ticks ((1 - f) D, then f D): at the corners
+    of a 7 x 4 m rectangle the slip law's cap and threshold then lost 0.25 deg per corner."""
+    from scipy.signal import lfilter
+
+    q = math.exp(-SLIP_SUB_S / tau)
+    f = float(np.mean(q ** np.arange(1, M + 1)))
+    Q = q**M
+    c = lfilter([1.0, -Q], [1.0 - f, f * (1.0 - Q) - (1.0 - f) * Q], v, axis=0)
+    m = lfilter([0.0, 1.0 - Q], [1.0, -Q], c, axis=0)
+    return c, m
 
 
 def slip_loss(pr: Prepared, P: dict, truck: int, k: float) -> np.ndarray:
     """(n-1, 2) floor travel the slip law adds per tick (negative: the wheel spun).
 
-    The catalog's law (host_sim/src/world.c slip_factor) acts on the acceleration of the wheel over
-    one physics step. A 40 ms count cannot see that step, but it sees the command steps that cause
-    it: the mean wheel speed changes from tick to tick by dv, and a drive following its command
-    with a first-order lag tau (slip.tau_s, a nuisance fitted with k) accelerates as
-    dv / tau e^(-t / tau). Integrating slip fraction x speed over the tick gives the lost travel.
-    Uncapped and with a0 = 0 this is k (v1^2 - v0^2) / 2 whatever tau is; the cap and a0 make tau
-    matter, which is why it is fitted (the blind check draws it, hidden, from 2-8 ms)."""
+    The catalog's law (host_sim/src/world.c slip_factor) acts on the acceleration of the drive
+    over each 1 ms physics step. A count over a whole tick cannot see that step, but the tick's
+    command can be recovered behind the recorded mean speeds (`drive_commands`) for a drive with
+    lag tau (slip.tau_s, a nuisance fitted with k; the blind check hides 2-8 ms), and the speed
+    in every sub-step follows from it: slip fraction x speed is integrated sub-step by sub-step,
+    spinning where the speed grows and dragging where it shrinks (a reversing wheel does both in
+    one tick)."""
     tau = max(P.get("slip.tau_s", 0.004), 1e-4)
     a0 = P.get("slip.a0_m_s2", 0.5)
     cap = P.get("slip.max_fraction", 0.2)
+    key = (truck, k, tau, a0, cap)
+    hit = pr.slip_cache.get(key)
+    if hit is not None:  # fits re-evaluate one (k, tau) for every other parameter they move
+        return hit
+    M = max(1, round(float(np.median(pr.dt)) / SLIP_SUB_S))
     v = pr.ds[:, truck, :] / pr.dt[:, None]  # mm/s, mean over each tick
-    vp = np.vstack([v[:1], v[:-1]])  # previous tick (the first tick: no step)
-    dv = v - vp
-    m = np.arange(SLIP_SUBSTEPS, dtype=float)
+    c, m0 = drive_commands(v, tau, M)
     g = 1.0 - math.exp(-SLIP_SUB_S / tau)
-    decay = np.exp(-m * SLIP_SUB_S / tau)  # (M,)
     out = np.zeros_like(v)
-    # only steps whose first sub-step exceeds a0 slip at all (count noise alone never does)
-    sel = np.abs(dv) * (g / SLIP_SUB_S * 1e-3) > a0
-    if not sel.any():
-        return out
-    dvs, vps = dv[sel], vp[sel]
-    acc = np.abs(dvs)[:, None] * (g / SLIP_SUB_S * 1e-3) * decay  # m/s^2, (nsel, M)
-    sfr = np.minimum(k * np.maximum(acc - a0, 0.0), cap)
-    vm = vps[:, None] + dvs[:, None] * (1.0 - decay * (1.0 - g))  # speed in each sub-step
-    up = (np.abs(v[sel]) >= np.abs(vps))[:, None]
-    per = np.where(up, -sfr, sfr / (1.0 - sfr)) * vm * SLIP_SUB_S
-    out[sel] = per.sum(axis=-1)
+    # only ticks whose first (largest) sub-step acceleration exceeds a0 slip at all
+    a_first = np.abs(c - m0) * (g / SLIP_SUB_S * 1e-3)
+    sel = a_first > a0
+    if sel.any():
+        # the acceleration decays by q = 1 - g per sub-step: beyond J sub-steps none exceeds a0
+        J = M
+        if a0 > 0.0:
+            J = int(min(M, 1 + math.ceil(math.log(a0 / a_first[sel].max()) / math.log(1.0 - g))))
+        out[sel] = _slip_substeps(c[sel], m0[sel], g, J, k, a0, cap)
+    if len(pr.slip_cache) > 16:
+        pr.slip_cache.clear()
+    pr.slip_cache[key] = out
     return out
+
+
+def _slip_substeps(c, m0, g, J, k, a0, cap) -> np.ndarray:
+    """Slip travel of the first J sub-steps of the selected ticks (see slip_loss)."""
+    cs, ms = c[:, None], m0[:, None]
+    qj = (1.0 - g) ** np.arange(J + 1)  # (J + 1,): sub-step j = 0 is the tick's start
+    vm = cs + (ms - cs) * qj  # (nsel, M + 1) speed after each sub-step
+    acc = np.abs(np.diff(vm, axis=1)) / SLIP_SUB_S * 1e-3  # m/s^2
+    sfr = np.minimum(k * np.maximum(acc - a0, 0.0), cap)
+    up = np.abs(vm[:, 1:]) >= np.abs(vm[:, :-1])
+    per = np.where(up, -sfr, sfr / (1.0 - sfr)) * vm[:, 1:] * SLIP_SUB_S
+    return per.sum(axis=-1)
 
 
 def integrate(ds: np.ndarray, b: float, lat: np.ndarray, pose0=(0.0, 0.0, 0.0)) -> np.ndarray:
@@ -239,12 +282,30 @@ def integrate(ds: np.ndarray, b: float, lat: np.ndarray, pose0=(0.0, 0.0, 0.0)) 
     return np.column_stack([x, y, th])
 
 
+def _track(pr: Prepared, P: dict, truck: int) -> np.ndarray:
+    """One truck's dead-reckoned track from the origin under P (cached per run: a clapper's
+    clamp needs both trucks for each, and fits ask for each truck in turn)."""
+    key = (
+        truck,
+        tuple(sorted(P.items())),
+        tuple((b["truck"], b["wheel"], b["s0"], b["h"]) for b in pr.bumps),
+    )
+    hit = pr.track_cache.get(key)
+    if hit is None:
+        if len(pr.track_cache) > 8:
+            pr.track_cache.clear()
+        hit = pr.track_cache[key] = integrate(*floor_travel(pr, P, truck))
+    return hit
+
+
 def dead_reckon(pr: Prepared, P: dict, truck: int = 0, pose0=(0.0, 0.0, 0.0)) -> np.ndarray:
-    ds, bt, lat = floor_travel(pr, P, truck)
-    p = integrate(ds, bt, lat, pose0)
+    if tuple(pose0) == (0.0, 0.0, 0.0):
+        p = _track(pr, P, truck)
+    else:
+        p = integrate(*floor_travel(pr, P, truck), pose0)
     if pr.link is None or len(pr.R) < 2:
-        return p
-    return _clamp_link(pr, p, integrate(*floor_travel(pr, P, 1 - truck)), truck, pose0)
+        return p.copy()
+    return _clamp_link(pr, p, _track(pr, P, 1 - truck), truck, pose0)
 
 
 def _clamp_link(pr: Prepared, p: np.ndarray, q: np.ndarray, truck: int, pose0) -> np.ndarray:
@@ -274,7 +335,7 @@ def _clamp_link(pr: Prepared, p: np.ndarray, q: np.ndarray, truck: int, pose0) -
         out_of &= gate[: ln.size]
     bad = np.flatnonzero(out_of)
     if bad.size == 0:
-        return p
+        return p.copy()
     i0 = max(int(bad[0]), 1)
     da, db = np.diff(pa[:, :2], axis=0), np.diff(pb[:, :2], axis=0)
     xa, ya = float(pa[i0 - 1, 0]), float(pa[i0 - 1, 1])

@@ -45,6 +45,7 @@ def _censored(x: np.ndarray, code: np.ndarray, step: float, angle: bool) -> np.n
 
 class TruthMode:
     name = "truth"
+    gof = True  # its noise is measured per sample (TruthMode.noise_diffs): a fit test holds
 
     def __init__(self, pr: Prepared, robot: Robot) -> None:
         tr = pr.run.truth
@@ -111,6 +112,12 @@ class TruthMode:
                 else ["alpha_rad"]
             )
         return ch
+
+    def noise_weights(self) -> np.ndarray:
+        """Expected z^2 per value of each channel under noise alone (fit.Problem.e0)."""
+        w = np.ones(len(self.channels()))
+        w[3 * self.trucks :] = 0.0  # censored linkage readings: zero inside the cell
+        return w
 
     def residuals(self, P: dict) -> np.ndarray:
         cols = []
@@ -194,6 +201,22 @@ class TruthMode:
             out[:, 3 * t + 1] = var / b**2 * Lt**2 / 3.0
         return out
 
+    def noise_diffs(self, truck: int) -> tuple[np.ndarray, np.ndarray]:
+        """Second differences of the truth-minus-model track at the truth's own samples:
+        (positions, x and y pooled; headings) of one truck, from evenly spaced triples only.
+
+        The counts-driven nominal model removes the robot's motion, and what an effect adds
+        changes slowly from sample to sample, so the second difference of the residual is the
+        truth's sample noise n(k+1) - 2 n(k) + n(k-1), variance 6 sigma^2 for white noise; bumps
+        and speed changes are a few outliers a robust spread ignores."""
+        m = self.anchored({}, truck)
+        r = self.tpose[:, truck, :] - m
+        r[:, 2] = np.unwrap(r[:, 2])
+        dt = np.diff(self.tt)
+        even = np.abs(dt[1:] - dt[:-1]) <= 1e-6 * np.maximum(dt[1:], 1e-9)
+        d2 = (r[2:] - 2.0 * r[1:-1] + r[:-2])[even]
+        return d2[:, :2].ravel(), d2[:, 2]
+
     def stationary(self) -> np.ndarray:
         return np.all(self.wtravel.reshape(-1, self.i.size) < 1e-9, axis=0)
 
@@ -209,9 +232,12 @@ class TruthMode:
 class ReturnsMode:
     name = "returns"
 
-    def __init__(self, pr: Prepared, robot: Robot) -> None:
+    def __init__(self, pr: Prepared, robot: Robot, accuracy: tuple | None = None) -> None:
         assert pr.run.ret is not None
         self.pr, self.ret = pr, pr.run.ret
+        # the return measurement's accuracy (mm, rad), when the user states it: the noise floor
+        # against which a spread of the returns is evidence (roughness) rather than noise
+        self.accuracy = accuracy
 
     def channels(self) -> list[str]:
         return ["x_mm", "y_mm", "theta_rad"]
@@ -220,8 +246,37 @@ class ReturnsMode:
         p = dead_reckon(self.pr, P, 0)[-1]
         return np.array([[self.ret[0] - p[0], self.ret[1] - p[1], wrap_rad(self.ret[2] - p[2])]])
 
-    def extra_var(self, P: dict) -> None:
-        return None
+    def extra_var(self, P: dict) -> np.ndarray | None:
+        """Roughness's spread of the return pose, when the measurement's accuracy is known.
+
+        Each grain shortens one wheel's floor travel by dd (central moment m2 - m1^2 plus the
+        grain count's renewal spread, as in TruthMode.extra_var). A shortfall d of wheel w at
+        tick k moves the truck back by d / 2 along its heading u_k and turns it by
+        -/+ d / b (left / right), which carries the rest of the path sideways: the return pose
+        moves by g = (-u_k / 2 -/+ J (p_end - p_k) / b, -/+ 1 / b) d, J the 90 deg rotation.
+        Var(return) = sum over ticks and wheels of grains x var(dd) x g^2 (the diagonal)."""
+        h = P.get("roughness.max_height_mm", 0.0)
+        if h <= 0 or self.accuracy is None:
+            return None
+        m1, m2 = rough_moments(self.pr.R[0], h)
+        cv2 = P.get("roughness.jitter", 0.5) ** 2 / 3.0
+        var_grain = m2 - m1 * m1 + cv2 * m1 * m1
+        n_grain = np.abs(self.pr.ds[:, 0, :]) / P.get("roughness.spacing_mm", 20.0)  # (n-1, 2)
+        p = dead_reckon(self.pr, P, 0)
+        pm = 0.5 * (p[:-1] + p[1:])
+        c, s_ = np.cos(pm[:, 2]), np.sin(pm[:, 2])
+        rx, ry = p[-1, 0] - pm[:, 0], p[-1, 1] - pm[:, 1]  # to the return point
+        b = self.pr.b[0]
+        var = np.zeros(3)
+        for w, sw in ((0, 1.0), (1, -1.0)):  # a left-wheel shortfall turns the truck left
+            gx = -0.5 * c - sw * ry / b
+            gy = -0.5 * s_ + sw * rx / b
+            q = n_grain[:, w] * var_grain
+            var += [np.sum(q * gx * gx), np.sum(q * gy * gy), np.sum(q) / b**2]
+        return var[None, :]
+
+    def noise_weights(self) -> np.ndarray:
+        return np.ones(len(self.channels()))
 
     def gap(self, P: dict) -> float:
         r = self.residuals(P)[0]
@@ -355,6 +410,9 @@ class LinkageMode:
 
     def extra_var(self, P: dict) -> None:
         return None
+
+    def noise_weights(self) -> np.ndarray:
+        return np.ones(len(self.channels()))
 
     def gap(self, P: dict) -> float:
         r = self._pred(P)
