@@ -109,13 +109,9 @@ def fit_hypothesis(
     if "bumps" not in parts:
         P, se = fit_params(prob, keys, warm=warm)
         return evaluate(prob, name, P, se, len(keys))
-    if floor_bumps is not None and all(p in BUMPS_REUSE_WITH for p in parts if p != "bumps"):
-        # the step detector cancels slow drift, so next to a partner that only drifts (ed) or
-        # moves nothing the detector sees the single's floor bumps serve: detection is most of a
-        # diagnosis's time. Partners that change a spot turn's angle (eb, es, slip, roughness's
-        # mean) put heading steps at the turns, which the nominal model's detector took for
-        # bumps (nine "bumps" per UMBmark run under eb 1.013, the real ones missed): with them
-        # the bumps are detected again with the partner's fit in the model.
+    if floor_bumps is not None:
+        # detection is most of a diagnosis's time: the caller passes the floor bumps found
+        # under a model fit for this pair (diagnose: bumps_for)
         fb = floor_bumps
     else:
         P0 = {}
@@ -134,7 +130,7 @@ def fit_hypothesis(
 
 
 HELDOUT_BUMP_MIN_RUNS = 2
-# partners under which the single's floor bumps are reused (see fit_hypothesis)
+# partners under which the single's floor bumps are reused (diagnose: bumps_for)
 BUMPS_REUSE_WITH = {"ed", "skid", "rotary_bias", "link_bias"}
 # roughness inflates the variance: it can come first among the singles by absorbing another
 # effect's systematic misfit, so it is paired with the best others instead of taking their place
@@ -207,6 +203,25 @@ def diagnose(
     gof = prob.gof_z({})
     if null.bic - best.bic >= DBIC_SIGNIFICANT or (gof is not None and gof >= Z_GAP):
         top = [f.name for f in singles if f.name not in ABSORBERS][:N_PAIR_BASE]
+        detected: dict[str, list] = {}
+
+        def bumps_for(pair: str) -> list | None:
+            """Floor bumps for a pair with bumps. Next to a partner that only drifts (ed) or
+            moves nothing the step detector sees, the single's serve (found under the nominal
+            model). A partner that changes a spot turn's angle (eb, es, slip, roughness's mean)
+            puts heading steps at every turn, which the nominal model's detector took for
+            bumps (nine per UMBmark run under Eb 1.013, the real ones missed): those pairs
+            share one detection under the best single other than bumps and roughness."""
+            partner = next(x for x in pair.split("+") if x != "bumps")
+            if partner in BUMPS_REUSE_WITH:
+                return next((f.bumps for f in singles if f.name == "bumps"), None)
+            if "best" not in detected:
+                others = [f for f in singles if f.name != "bumps"]
+                ref = next((f for f in others if f.name not in ABSORBERS), others[0])
+                P0 = {k: v for k, v in ref.params.items() if not k.startswith("bumps.")}
+                detected["best"] = cluster_bumps(detect_bumps(prob.items, P0, sig_head))
+            return detected["best"]
+
         pairs = list(itertools.combinations(top, 2))
         pairs += [(a, b) for a in ABSORBERS for b in top if any(f.name == a for f in singles)]
         for a, b in pairs:
@@ -214,7 +229,7 @@ def diagnose(
             if progress:
                 progress(f"fitting {name}")
             basef = next((f for f in singles if f.name == name.split("+")[0]), None)
-            fb = next((f.bumps for f in singles if f.name == "bumps"), None)
+            fb = bumps_for(name) if "bumps" in name.split("+") else None
             warm = {}
             for f in singles:
                 if f.name in (a, b):

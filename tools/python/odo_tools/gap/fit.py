@@ -340,34 +340,23 @@ def detect_bumps(items: list, P: dict, sigma_head: float) -> list[dict]:
                     tick_idx = np.clip(tick_idx, 0, pr.t.size - 1)
                     ta, tb = int(tick_idx[0]), int(tick_idx[-1]) + 1
                     ti_loc = tick_idx - ta
+                    # offset and slope of the drift under the step enter linearly: projected
+                    # out (variable projection), the fit moves only height and position
+                    tau = tt[idx] - tt[kc]
+                    Q, _ = np.linalg.qr(np.column_stack([np.ones_like(tau), tau]))
+                    y0 = e[idx]
 
-                    def res(
-                        x,
-                        w=w,
-                        idx=idx,
-                        ti=ti_loc,
-                        pr=pr,
-                        truck=truck,
-                        e=e,
-                        tt=tt,
-                        kc=kc,
-                        ta=ta,
-                        tb=tb,
-                    ):
-                        h, s0, c0, c1 = x
-                        prof = _signed_excess(pr, truck, w, h, s0, ta, tb)[ti]
-                        return (e[idx] - c0 - c1 * (tt[idx] - tt[kc]) - prof) / 1e-4
+                    def res(x, pr=pr, w=w, ti=ti_loc, truck=truck, ta=ta, tb=tb, Q=Q, y0=y0):
+                        y = y0 - _signed_excess(pr, truck, w, x[0], x[1], ta, tb)[ti]
+                        return (y - Q @ (Q.T @ y)) / 1e-4
 
                     s_mid = Sa[w, kc]
                     for hs in (h0,):
                         try:
                             r = least_squares(
                                 res,
-                                [hs, s_mid - 30.0, e[lo], 0.0],
-                                bounds=(
-                                    [0.2, s_lo - 100, -np.inf, -np.inf],
-                                    [50.0, s_hi, np.inf, np.inf],
-                                ),
+                                [hs, s_mid - 30.0],
+                                bounds=([0.2, s_lo - 100], [50.0, s_hi]),
                                 max_nfev=80,
                             )
                         except ValueError:
