@@ -30,8 +30,8 @@ test: build ## run every test (ctest: Unity, Check, pytest, lint, Cortex-M4 cros
 demo: build ## run the main job on built-in sample data
 	@bash tools/demo/demo.sh
 
-bench: build ## print benchmark figures as JSON (build/host/bin/odo-bench --json)
-	@build/host/bin/odo-bench --json
+bench: release ## print benchmark figures as JSON (-O2 build: build/release/bin/odo-bench --json)
+	@build/release/bin/odo-bench --json
 
 clean: ## remove build output (keeps .venv)
 	rm -rf build

@@ -1,6 +1,6 @@
 """odo-gap blind (issue 7 item 3), small and seeded: the generator withholds each case's effect,
 the diagnosing processes cannot open the keys, and loose versions of the targets hold. The full
-acceptance run is `odo-gap blind --cases 60 --seed 4 --out out/blind` (prints the figures; README).
+acceptance run is `odo-gap blind --cases 60 --seed 41 --out out/blind` (prints the figures; README).
 Seed 5's eight cases hold a no-effect LabMate-with-trailer (the vehicle that used to raise false
 alarms), ed, eb, roughness and four out-of-catalog cases."""
 
