@@ -103,3 +103,12 @@ def test_mode_without_its_frames(good: Path, tmp_path: Path) -> None:
 def test_bad_return_accuracy(good: Path, tmp_path: Path, value: str) -> None:
     fails(good, tmp_path, "--return-accuracy", extra=("--mode", "returns", "--return-accuracy",
                                                       value))
+
+
+@pytest.mark.parametrize("rng", [[1100.0, 1200.0], [900.0], "900,1100", [900.0, "x"]])
+def test_bad_linkage_range(good: Path, tmp_path: Path, rng) -> None:
+    r = json.loads((SRC / "host_sim/robots/clapper.json").read_text())
+    r["linkage"]["range_mm"] = rng
+    rp = tmp_path / "clapper-range.json"
+    rp.write_text(json.dumps(r))
+    fails(good, tmp_path, "clapper-range.json", "linkage.range_mm", robot=str(rp))

@@ -64,9 +64,7 @@ def main(argv: list[str] | None = None) -> int:
             from .diagnose import diagnose, write_report
 
             t0 = time.perf_counter()
-            rep = diagnose(
-                a.real, a.robot, a.holdout, a.seed, a.mode, _progress(a.quiet), acc
-            )
+            rep = diagnose(a.real, a.robot, a.holdout, a.seed, a.mode, _progress(a.quiet), acc)
             write_report(rep, a.out)
             v = rep["verdict"]
             print(

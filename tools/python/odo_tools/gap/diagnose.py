@@ -171,12 +171,11 @@ def diagnose(
     prs = [prepare(r, robot) for r in runs]
     M = MODES[mode]
     try:
+        extra = ()
         if mode == "returns" and return_accuracy is not None:
             mm, deg = return_accuracy
-            acc = (mm, mm, math.radians(deg))
-            items = [M(pr, robot, acc) for pr in prs]
-        else:
-            items = [M(pr, robot) for pr in prs]
+            extra = ((mm, mm, math.radians(deg)),)
+        items = [M(pr, robot, *extra) for pr in prs]
     except ValueError as e:
         raise GapInputError(real, f"mode {mode}: {e}") from None
     assign_paths(prs)

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 from scipy.optimize import least_squares
@@ -119,7 +120,7 @@ class Problem:
     def wresid(self, P: dict) -> np.ndarray:
         return (self.resid(P) / self.sigma).ravel()
 
-    @property
+    @cached_property
     def e0(self) -> float:
         """Expected chi^2 under noise alone: one per Gaussian value; the truth's linkage readings
         are interval-censored (modes._censored), zero at the truth."""
@@ -147,11 +148,11 @@ def _mad(x: np.ndarray) -> float:
 
 def estimate_sigma(items: list, mode: str) -> np.ndarray:
     """Per-channel noise of the nominal model's residuals (see module doc)."""
-    r = np.vstack([it.residuals({}) for it in items])
-    floor = np.array([2e-5 if ch.endswith("_rad") else 0.02 for ch in items[0].channels()])
     if mode == "returns" and items[0].accuracy is not None:
         # the user's measurement accuracy: a spread beyond it is evidence (roughness), not noise
         return np.asarray(items[0].accuracy, dtype=float)
+    r = np.vstack([it.residuals({}) for it in items])
+    floor = np.array([2e-5 if ch.endswith("_rad") else 0.02 for ch in items[0].channels()])
     if mode == "returns":
         # no repeated-measurement floor exists: the spread of the runs around their direction's
         # mean is the non-systematic part (000 s. 3.3); a floor keeps it from vanishing
@@ -304,10 +305,8 @@ def detect_bumps(items: list, P: dict, sigma_head: float) -> list[dict]:
             m = max(3, round(0.5 / dt))
             if e.size < 4 * m:
                 continue
-            k = np.arange(e.size)
             D = _step_detector(e, m)
-            sd = 1.4826 * np.median(np.abs(D - np.median(D)))
-            thr = max(8.0 * sd, 6.0 * sigma_head / math.sqrt(m), 2e-4)
+            thr = max(8.0 * _mad(D), 6.0 * sigma_head / math.sqrt(m), 2e-4)
             masked = np.zeros(D.size, dtype=bool)
             h_grid = np.linspace(0.2, 50.0, 400)
             dd_grid = bump_dd(pr.R[truck], h_grid)
@@ -319,7 +318,7 @@ def detect_bumps(items: list, P: dict, sigma_head: float) -> list[dict]:
                 if absd[q] < thr:
                     break
                 masked[max(0, q - 2 * m) : q + 2 * m] = True
-                kc = int(k[q])
+                kc = q
                 lo, hi = max(0, kc - 2 * m), min(e.size - 1, kc + 2 * m)
                 best = None
                 # a bump under the left wheel turns the truck left while that wheel rolls
@@ -351,18 +350,17 @@ def detect_bumps(items: list, P: dict, sigma_head: float) -> list[dict]:
                         return (y - Q @ (Q.T @ y)) / 1e-4
 
                     s_mid = Sa[w, kc]
-                    for hs in (h0,):
-                        try:
-                            r = least_squares(
-                                res,
-                                [hs, s_mid - 30.0],
-                                bounds=([0.2, s_lo - 100], [50.0, s_hi]),
-                                max_nfev=80,
-                            )
-                        except ValueError:
-                            continue
-                        if best is None or r.cost < best[0]:
-                            best = (r.cost, w, r.x)
+                    try:
+                        r = least_squares(
+                            res,
+                            [h0, s_mid - 30.0],
+                            bounds=([0.2, s_lo - 100], [50.0, s_hi]),
+                            max_nfev=80,
+                        )
+                    except ValueError:
+                        continue
+                    if best is None or r.cost < best[0]:
+                        best = (r.cost, w, r.x)
                 if best is None:
                     continue
                 _, w, x = best

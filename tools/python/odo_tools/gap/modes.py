@@ -43,6 +43,12 @@ def _censored(x: np.ndarray, code: np.ndarray, step: float, angle: bool) -> np.n
     return np.clip(d, -tol, step + tol) - d
 
 
+def _grain_count_cv2(P: dict) -> float:
+    """Squared coefficient of variation of the grain count: gaps spacing * (1 + jitter U(-1, 1))
+    make a renewal count of variance n cv^2, cv^2 = jitter^2 / 3."""
+    return P.get("roughness.jitter", 0.5) ** 2 / 3.0
+
+
 class TruthMode:
     name = "truth"
     gof = True  # its noise is measured per sample (TruthMode.noise_diffs): a fit test holds
@@ -179,9 +185,8 @@ class TruthMode:
         out = np.zeros((self.i.size, len(self.channels())))
         # the mean grain is in the model (floor_travel), so a window's residual varies by the
         # grains' central moment, m2 - m1^2 (m2 alone overstated it ~2.8x for uniform heights and
-        # left a mean shortfall an es had to make up), plus the grain count's own spread: gaps
-        # spacing * (1 + jitter U(-1, 1)) give a renewal count of variance n cv^2, cv^2 = j^2 / 3
-        cv2 = P.get("roughness.jitter", 0.5) ** 2 / 3.0
+        # left a mean shortfall an es had to make up), plus the grain count's own spread
+        cv2 = _grain_count_cv2(P)
         for t in range(self.trucks):
             # each wheel: grains cut by the window's ends count by their share only
             # (model.rough_window_var; without it the variance was ~20 % too high on 0.4 s
@@ -259,7 +264,7 @@ class ReturnsMode:
         if h <= 0 or self.accuracy is None:
             return None
         m1, m2 = rough_moments(self.pr.R[0], h)
-        cv2 = P.get("roughness.jitter", 0.5) ** 2 / 3.0
+        cv2 = _grain_count_cv2(P)
         var_grain = m2 - m1 * m1 + cv2 * m1 * m1
         n_grain = np.abs(self.pr.ds[:, 0, :]) / P.get("roughness.spacing_mm", 20.0)  # (n-1, 2)
         p = dead_reckon(self.pr, P, 0)
