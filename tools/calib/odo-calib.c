@@ -17,6 +17,7 @@
 
 #include "acceptance.h"
 #include "calib_core.h"
+#include "fit_cli.h"
 #include "image.h"
 #include "params_json.h"
 #include "returns_csv.h"
@@ -45,6 +46,9 @@ static void usage(FILE *f)
             "  verify --image FW            check the image's block (layout, version, CRC, ranges)\n"
             "  export --params P.json|P.bin --format ros2\n"
             "      diff_drive_controller multipliers (YAML) for ros2_controllers\n"
+            "  fit --runs DIR... --robot R.json [--fit GLOB...] [--judge GLOB...] [--out-params P]... [--json]\n"
+            "      calibrate Ed, Eb, Es and the turn-radius-dependent wheelbase from runs on any path\n"
+            "      with a truth track or return poses (odo-import folders); held-out before/after.\n"
             "  acceptance [--robots N] [--seed S] [--runs N] [--json] [--no-tape] [--quiet]\n"
             "      simulated labmates (Ed ~ U[0.995, 1.005], b ~ U[0.97, 1.03] x 340 mm, floor\n"
             "      roughness): Emax,syst before/after one pass, exact and paper methods; E-7/E-8\n"
@@ -140,7 +144,7 @@ static int write_atomic(const char *path, const void *data, size_t len)
 }
 
 /// Parameters as JSON text (malloc'd) or as the 128-byte block, by the output's extension.
-static int write_params(const char *path, const odo_params_t *p)
+int calib_write_params(const char *path, const odo_params_t *p)
 {
     if (ends_with(path, ".bin")) {
         uint8_t block[ODO_PARAMS_SIZE];
@@ -317,7 +321,7 @@ static int cmd_umbmark(int argc, char **argv)
     if (out != NULL) {
         odo_params_t np;
         calib_apply(&in_force, &c, &np);
-        if (write_params(out, &np) != 0) {
+        if (calib_write_params(out, &np) != 0) {
             return EXIT_FAIL;
         }
     }
@@ -570,6 +574,9 @@ int main(int argc, char **argv)
     }
     if (strcmp(cmd, "export") == 0) {
         return cmd_export(argc - 2, argv + 2);
+    }
+    if (strcmp(cmd, "fit") == 0) {
+        return calib_fit_main(argc - 2, argv + 2);
     }
     if (strcmp(cmd, "acceptance") == 0) {
         return calib_acceptance_main(argc - 2, argv + 2);

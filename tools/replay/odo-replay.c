@@ -168,7 +168,8 @@ static void write_summary(FILE *f, const char *mode, const char *input, const re
             st->error_frames, st->bus_off, st->time_backwards, st->late, st->dup_dropped, s->out_frames,
             r->app.tx_dropped, odo_params_status_str(r->app.params_status));
     if (ls != NULL) {
-        fprintf(f, ", \"log_lines\": %" PRIu64 ", \"log_blank\": %" PRIu64, ls->lines, ls->blank);
+        fprintf(f, ", \"log_lines\": %" PRIu64 ", \"log_blank\": %" PRIu64 ", \"log_can_fd_skipped\": %" PRIu64,
+                ls->lines, ls->blank, ls->fd_skipped);
     }
     if (ss != NULL) {
         fprintf(f, ", \"bus\": {\"rx_frames\": %" PRIu64 ", \"rx_dropped\": %" PRIu64 ", \"tx_frames\": %" PRIu64
@@ -409,6 +410,10 @@ int main(int argc, char **argv)
     if (r.stats.time_backwards > 0U && !quiet) {
         fprintf(stderr, "odo-replay: warning: %" PRIu64 " frames stamped before the previous frame "
                         "(flagged TIME_BACKWARDS)\n", r.stats.time_backwards);
+    }
+    if (log != NULL && reader.stats.fd_skipped > 0U && !quiet) {
+        fprintf(stderr, "odo-replay: %" PRIu64 " CAN FD lines (another node's traffic) skipped\n",
+                reader.stats.fd_skipped);
     }
     if (r.stats.ignored > 0U && !quiet) {
         fprintf(stderr, "odo-replay: %" PRIu64 " frames not consumed (unknown ID, RTR, extended or output "
