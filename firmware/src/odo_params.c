@@ -275,7 +275,7 @@ odo_params_status_t odo_params_validate(const odo_params_t *p, odo_param_field_t
     }
     if (p->vehicle > (uint8_t)ODO_VEHICLE_SET) {
         field = ODO_PF_VEHICLE;
-    } else if ((p->counter_bits != 16U) && (p->counter_bits != 24U) && (p->counter_bits != 32U)) {
+    } else if ((p->counter_bits < 8U) || (p->counter_bits > 32U)) {
         field = ODO_PF_COUNTER_BITS;
     } else if (p->heading_form > (uint8_t)ODO_HEADING_PAPER) {
         field = ODO_PF_HEADING_FORM;

@@ -459,8 +459,8 @@ static void test_int32_min_is_out_of_every_signed_range(void)
     }
 }
 
-/// counter_bits is a set, not an interval: only 16, 24 and 32.
-static void test_counter_bits_accepts_only_16_24_32(void)
+/// counter_bits: the widths real decoders have, 8 to 32 bits (a 12-bit MCU timer included).
+static void test_counter_bits_accepts_8_to_32(void)
 {
     for (unsigned v = 0; v <= 255; v++) {
         odo_params_t p;
@@ -468,7 +468,7 @@ static void test_counter_bits_accepts_only_16_24_32(void)
         odo_params_defaults(&p);
         p.counter_bits = (uint8_t)v;
         snprintf(msg, sizeof msg, "counter_bits %u", v);
-        if (v == 16 || v == 24 || v == 32) {
+        if (v >= 8 && v <= 32) {
             expect_block(&p, ODO_PARAMS_OK, ODO_PF_NONE, 0, msg);
         } else {
             expect_block(&p, ODO_PARAMS_ERR_RANGE, ODO_PF_COUNTER_BITS, 0, msg);
@@ -732,7 +732,7 @@ int main(void)
     RUN_TEST(test_wrong_length_field_is_refused_even_with_a_correct_crc);
     RUN_TEST(test_each_range_rejects_just_outside_and_accepts_just_inside);
     RUN_TEST(test_int32_min_is_out_of_every_signed_range);
-    RUN_TEST(test_counter_bits_accepts_only_16_24_32);
+    RUN_TEST(test_counter_bits_accepts_8_to_32);
     RUN_TEST(test_truck_flags_accept_only_the_invert_bits);
     RUN_TEST(test_length_limits_must_be_ordered_and_within_1mm_to_20m);
     RUN_TEST(test_unused_truck_record_must_still_be_sane);

@@ -27,7 +27,7 @@ typedef struct {
     int64_t  dist_mm_q40[2];  ///< distance per count, [ODO_LEFT, ODO_RIGHT]: cL/R * cm (Eq. 6.35)
     uint64_t turn_q64[2];     ///< heading change per count: dist / (2 pi b_eff) (Eq. 2.4), turns Q64
     uint32_t max_counts;      ///< largest believable |delta| per tick (from max_wheel_speed_mm_s)
-    uint8_t  counter_bits;    ///< decoder counter width (16, 24, 32)
+    uint8_t  counter_bits;    ///< decoder counter width (8..32)
     uint8_t  invert;          ///< ODO_TRUCK_INVERT_* flags
     uint8_t  heading_form;    ///< odo_heading_form_t
 } odo_model_t;
@@ -65,7 +65,7 @@ odo_model_status_t odo_model_init(odo_model_t *m, const odo_truck_params_t *tp, 
                                   uint32_t max_wheel_speed_mm_s);
 
 /// Signed difference cur - prev of two raw counter readings modulo 2^bits (bits in [1, 32]),
-/// interpreted in [-2^(bits-1), 2^(bits-1)). Handles every wrap of a 16, 24 or 32-bit counter.
+/// interpreted in [-2^(bits-1), 2^(bits-1)). Handles every wrap of an 8- to 32-bit counter.
 int32_t odo_count_delta(uint32_t prev, uint32_t cur, uint8_t bits);
 
 /// Reset a truck to a pose; the next reading sets the counter baseline.

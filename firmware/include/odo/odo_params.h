@@ -100,7 +100,7 @@ typedef struct {
 
 typedef struct {
     uint8_t  vehicle;              ///< odo_vehicle_t
-    uint8_t  counter_bits;         ///< wheel decoder counter width: 16, 24 or 32
+    uint8_t  counter_bits;         ///< wheel decoder counter width: [8, 32] (real decoders: 8-32)
     uint8_t  heading_form;         ///< odo_heading_form_t
     uint8_t  ipec_mode;            ///< odo_ipec_mode_t
     uint32_t tick_us;              ///< application step period; [1 ms, 1 s]; 40 ms (002 s. 4.1)

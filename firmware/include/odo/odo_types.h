@@ -38,7 +38,7 @@ typedef struct {
 /// One sample of a truck's two wheel-encoder counters, as the decoder (or the sensor frame) gives it.
 typedef struct {
     bool     present;      ///< a sample for this tick arrived; false: nothing arrived
-    uint8_t  bits;         ///< valid low bits in left/right_raw: 16, 24 or 32
+    uint8_t  bits;         ///< valid low bits in left/right_raw: 8..32
     uint8_t  seq;          ///< sender's sample sequence number (wraps at 256)
     uint8_t  status;       ///< sender's status bits, ODO_WHEEL_STATUS_*
     uint32_t left_raw;     ///< raw counter value, only the low `bits` bits are meaningful
