@@ -41,9 +41,7 @@ from .gap.errors import GapInputError
 from .gap.io import encode_payload, read_robot, write_candump
 
 MARKER = ".odo-import"
-RET_HEADER = (
-    "run,direction,x_abs_mm,y_abs_mm,theta_abs_deg,x_calc_mm,y_calc_mm,theta_calc_deg\n"
-)
+RET_HEADER = "run,direction,x_abs_mm,y_abs_mm,theta_abs_deg,x_calc_mm,y_calc_mm,theta_calc_deg\n"
 
 
 def parse_map(text: str | None) -> dict[str, str]:
@@ -104,7 +102,9 @@ def read_table(
                 raise GapInputError(path, f"NaN or infinite value in column {c}", i)
             vals.append(v)
         if ti is not None and data and vals[ti] <= data[-1][ti]:
-            raise GapInputError(path, f"time {vals[ti]:g} does not increase (time goes backwards)", i)
+            raise GapInputError(
+                path, f"time {vals[ti]:g} does not increase (time goes backwards)", i
+            )
         data.append(vals)
     if not data:
         raise GapInputError(path, "no data rows")
@@ -180,7 +180,9 @@ def import_ticks(
     for c in ("time", "left", "right"):
         if c not in tb:
             how = "--map" if columns is None else "--columns"
-            raise GapInputError(ticks, f"no '{c}' column (have {', '.join(tb)}; name it with {how})", 1)
+            raise GapInputError(
+                ticks, f"no '{c}' column (have {', '.join(tb)}; name it with {how})", 1
+            )
     t = tb["time"] - tb["time"][0]
     dt = np.diff(t)
     if dt.size and abs(np.median(dt) - robot.tick_s) > 0.05 * robot.tick_s:
@@ -292,7 +294,15 @@ def import_set(a: argparse.Namespace, files: list[Path], truths: list[Path] | No
         base = dst / f"run-{d}-{seen[d]:02d}"
         tr = truths[i] if truths else None
         calc = import_ticks(
-            f, Path(a.robot), base, tr, cols, tcols, a.cumulative, a.truth_units, mapping,
+            f,
+            Path(a.robot),
+            base,
+            tr,
+            cols,
+            tcols,
+            a.cumulative,
+            a.truth_units,
+            mapping,
             a.ticks_unit,
         )
         if calc is not None:
@@ -348,7 +358,9 @@ def main(argv: list[str] | None = None) -> int:
         if out.resolve() in inputs or any(out.resolve() in p.parents for p in inputs):
             raise GapInputError(out, "--out is (or holds) an input; choose a new folder")
         if out.exists() and not (out / MARKER).is_file():
-            raise GapInputError(out, "exists and was not written by odo-import; choose a new folder")
+            raise GapInputError(
+                out, "exists and was not written by odo-import; choose a new folder"
+            )
         if a.map and a.columns:
             ap.error("--map names header columns, --columns header-less ones: give one")
         sets = expand(a.ticks)
