@@ -62,7 +62,7 @@ def parse_map(text: str | None) -> dict[str, str]:
 def read_table(
     path: Path, columns: list[str] | None, mapping: dict[str, str] | None = None
 ) -> dict[str, np.ndarray]:
-    """A CSV as role -> column. Header-less with `columns`; else the header, renamed by `mapping`."""
+    """A CSV as role -> column: header-less with `columns`, else the header renamed by `mapping`."""
     try:
         f = path.open(newline="")
     except OSError as e:
