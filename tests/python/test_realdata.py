@@ -332,3 +332,93 @@ def test_optiodom_fit_judged_on_held_out_runs(tmp_path: Path) -> None:
     # measured x4.4 on the squares' held-out positions: short of 5x (README explains why)
     assert g["square"]["pos_factor"] >= 4
     assert doc["firmware_vs_double_max_mm"] < 0.1
+
+
+# --- ROS 2 bags (rosbags' own writer; no ROS install) ----------------------------------------
+
+def make_bag(path: Path, ticks: np.ndarray, truth: np.ndarray, joint_rate=100.0,
+             truth_type="geometry_msgs/msg/PoseStamped") -> None:
+    """A bag of JointState wheel positions (rad) and motion-capture truth at their own rates."""
+    from rosbags.rosbag2 import Writer
+    from rosbags.typesys import Stores, get_typestore
+
+    ts = get_typestore(Stores.ROS2_HUMBLE)
+    T = ts.types
+    t_tick = np.arange(ticks.shape[0]) * 0.05
+    ang = np.cumsum(ticks, axis=0) / CPR * 2 * math.pi
+
+    def hdr(t: float):
+        ns = min(round((t % 1) * 1e9), 999_999_999)
+        return T["std_msgs/msg/Header"](
+            stamp=T["builtin_interfaces/msg/Time"](sec=int(t), nanosec=ns), frame_id="odom")
+
+    with Writer(path, version=8) as w:
+        cj = w.add_connection("/joint_states", "sensor_msgs/msg/JointState", typestore=ts)
+        ct = w.add_connection("/mocap/pose", truth_type, typestore=ts)
+        msgs = []
+        for t in np.arange(0, t_tick[-1] + 1e-9, 1 / joint_rate):
+            pos = np.array([np.interp(t, t_tick, ang[:, 0]), 0.5, np.interp(t, t_tick, ang[:, 1])])
+            m = T["sensor_msgs/msg/JointState"](
+                header=hdr(100 + t), name=["wheel_left", "caster", "wheel_right"], position=pos,
+                velocity=np.zeros(3), effort=np.zeros(3))
+            msgs.append((100 + t, cj, ts.serialize_cdr(m, cj.msgtype)))
+        for t in np.arange(0, t_tick[-1] + 1e-9, 1 / 120):
+            x, y, th = (np.interp(t, t_tick, truth[:, k]) for k in range(3))
+            pose = T["geometry_msgs/msg/Pose"](
+                position=T["geometry_msgs/msg/Point"](x=x / 1000, y=y / 1000, z=0.0),
+                orientation=T["geometry_msgs/msg/Quaternion"](
+                    x=0.0, y=0.0, z=math.sin(th / 2), w=math.cos(th / 2)))
+            if truth_type.endswith("PoseStamped"):
+                m = T["geometry_msgs/msg/PoseStamped"](header=hdr(100 + t), pose=pose)
+            else:
+                cov = np.zeros(36)
+                z3 = T["geometry_msgs/msg/Vector3"](x=0.0, y=0.0, z=0.0)
+                m = T["nav_msgs/msg/Odometry"](
+                    header=hdr(100 + t), child_frame_id="base",
+                    pose=T["geometry_msgs/msg/PoseWithCovariance"](pose=pose, covariance=cov),
+                    twist=T["geometry_msgs/msg/TwistWithCovariance"](
+                        twist=T["geometry_msgs/msg/Twist"](linear=z3, angular=z3),
+                        covariance=cov))
+            msgs.append((100 + t, ct, ts.serialize_cdr(m, ct.msgtype)))
+        for t, c, raw in sorted(msgs, key=lambda r: r[0]):
+            w.write(c, int(t * 1e9), raw)
+
+
+@pytest.mark.parametrize("truth_type", ["geometry_msgs/msg/PoseStamped", "nav_msgs/msg/Odometry"])
+def test_ros2_bag_imports_wheels_and_truth(tmp_path: Path, truth_type: str) -> None:
+    ticks, truth = drive("circle", seed=3)
+    make_bag(tmp_path / "bag", ticks, truth, truth_type=truth_type)
+    robot = robot_file(tmp_path)
+    r = odo_import("ros2-bag", "--bag", str(tmp_path / "bag"), "--joints", "wheel_left,wheel_right",
+                   "--truth-topic", "/mocap/pose", "--robot", str(robot), "--out",
+                   str(tmp_path / "o"))
+    assert r.returncode == 0, r.stderr
+    lg = read_log(tmp_path / "o/run-fwd-01.log", read_robot(robot))
+    # the counts on the tick grid are the generator's running totals, wrapped at 12 bits
+    want = np.cumsum(ticks, axis=0) % 4096
+    n = lg.counts.shape[0]
+    assert n >= ticks.shape[0] - 1
+    assert np.array_equal(lg.counts[:, 0, 0], want[:n, 0])
+    assert np.array_equal(lg.counts[:, 0, 1], want[:n, 1])
+    tr = np.loadtxt(tmp_path / "o/run-fwd-01.truth.csv", delimiter=",", skiprows=1)
+    assert tr[100, 1] == pytest.approx(truth[100, 0], abs=0.05)
+    assert tr[100, 3] == pytest.approx(math.degrees(truth[100, 2]), abs=0.01)
+    ret = (tmp_path / "o/returns.csv").read_text().splitlines()[1].split(",")
+    assert math.isfinite(float(ret[5]))
+
+
+@pytest.mark.parametrize("args,expect", [
+    (["--joint-topic", "/wheels"], "no topic /wheels"),
+    (["--truth-topic", "/vicon"], "no topic /vicon"),
+    (["--joints", "left,right"], "/joint_states: no joint left, right"),
+])
+def test_ros2_bag_without_the_named_topics(tmp_path: Path, args: list[str], expect: str) -> None:
+    ticks, truth = drive("square", seed=4)
+    make_bag(tmp_path / "bag", ticks[:60], truth[:60])
+    base = {"--joints": "wheel_left,wheel_right", "--truth-topic": "/mocap/pose"}
+    base.update(dict(zip(args[::2], args[1::2], strict=True)))
+    flat = [x for kv in base.items() for x in kv]
+    r = odo_import("ros2-bag", "--bag", str(tmp_path / "bag"), *flat, "--robot",
+                   str(robot_file(tmp_path)), "--out", str(tmp_path / "o"))
+    assert r.returncode == 1 and expect in r.stderr and str(tmp_path / "bag") in r.stderr, r.stderr
+    assert "Traceback" not in r.stderr and not (tmp_path / "o").exists()

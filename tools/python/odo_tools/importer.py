@@ -1,5 +1,9 @@
 """odo-import: turn other robots' recordings into the project's log contracts.
 
+`odo-import ros2-bag --bag B... --joints L,R [--truth-topic T] --robot R.json --out OUT` reads
+ROS 2 bags (sensor_msgs/JointState wheel positions, nav_msgs/Odometry or geometry_msgs/PoseStamped
+truth) with the rosbags package, no ROS install; `odo-import ros2-bag --help` for details.
+
 `odo-import ticks-csv --ticks F|DIR... --robot R.json --out OUT` reads plain CSVs of wheel ticks
 (one run per file; a folder stands for its *.csv files but metadata.csv) and writes per run
 run-<dir>-NN.log (WHEEL_COUNTS_A frames via can/odometry.dbc, the counters accumulated and
@@ -171,17 +175,54 @@ def import_ticks(
     mapping: dict[str, str] | None = None,
     ticks_unit: str = "counts",
 ) -> tuple[float, float, float] | None:
-    """One run: out_base.log (+ .truth.csv). Time starts at the first row. Returns the firmware's
-    end pose (x mm, y mm, theta deg) when there is truth, for returns.csv."""
+    """One run from CSV: out_base.log (+ .truth.csv). Time starts at the first row. Returns the
+    firmware's end pose (x mm, y mm, theta deg) when there is truth, for returns.csv."""
+    tb = read_table(ticks, columns, mapping)
+    tt = None
+    src = ticks
+    if truth is not None and not (truth == ticks and truth_columns == columns):
+        tt = read_table(truth, truth_columns, mapping)
+        src = truth
+    elif all(c in tb for c in ("x", "y", "theta")) or truth is not None:
+        tt = tb
+    hint = "--map" if columns is None else "--columns"
+    return write_run(
+        tb,
+        tt,
+        robot_path,
+        out_base,
+        ticks,
+        src,
+        cumulative,
+        truth_units,
+        ticks_unit,
+        hint,
+        line_offset=0 if columns is not None else 1,
+    )
+
+
+def write_run(
+    tb: dict[str, np.ndarray],
+    tt: dict[str, np.ndarray] | None,
+    robot_path: Path,
+    out_base: Path,
+    ticks: Path | str,
+    src: Path | str,
+    cumulative: bool,
+    truth_units: str,
+    ticks_unit: str,
+    hint: str,
+    line_offset: int = 0,
+) -> tuple[float, float, float] | None:
+    """Write one run from tables (role -> array): the log, the truth track, the firmware's end
+    pose (returned when there is truth). `ticks`/`src` name the sources in messages."""
     robot = read_robot(robot_path)
     if robot.n_trucks != 1:
-        raise GapInputError(robot_path, "ticks-csv imports a one-truck (labmate-like) robot")
-    tb = read_table(ticks, columns, mapping)
+        raise GapInputError(robot_path, "odo-import writes a one-truck (labmate-like) robot")
     for c in ("time", "left", "right"):
         if c not in tb:
-            how = "--map" if columns is None else "--columns"
             raise GapInputError(
-                ticks, f"no '{c}' column (have {', '.join(tb)}; name it with {how})", 1
+                ticks, f"no '{c}' column (have {', '.join(tb)}; name it with {hint})", 1
             )
     t = tb["time"] - tb["time"][0]
     dt = np.diff(t)
@@ -203,7 +244,7 @@ def import_ticks(
                 ticks,
                 f"{w}: {int(step.max())} counts in one cycle, faster than the robot's "
                 f"max_wheel_speed_mm_s (wrong --ticks-unit or --cumulative?)",
-                i + (0 if columns is not None else 1),
+                i + line_offset,
             )
         if robot.trucks[0]["invert_" + w]:
             cum = -cum
@@ -219,18 +260,12 @@ def import_ticks(
         },
     )
     write_candump(out_base.with_suffix(".log"), [(t, 0x110, pay)])
-    if truth is None and not all(c in tb for c in ("x", "y", "theta")):
+    if tt is None:
         return None
-    if truth is None or (truth == ticks and truth_columns == columns):
-        tt = tb
-        src = ticks
-    else:
-        tt = read_table(truth, truth_columns, mapping)
-        src = truth
     for c in ("time", "x", "y", "theta"):
         if c not in tt:
             raise GapInputError(src, f"no '{c}' column (have {', '.join(tt)})", 1)
-    if src != ticks and tt["time"].size != n:
+    if tt is not tb and tt["time"].size != n:
         raise GapInputError(
             src,
             f"{tt['time'].size} truth rows but {ticks} has {n} tick rows "
@@ -317,6 +352,67 @@ def import_set(a: argparse.Namespace, files: list[Path], truths: list[Path] | No
     (dst / MARKER).write_text("written by odo-import; it replaces this folder on a re-import\n")
 
 
+def finish(out: Path, tmp: Path) -> None:
+    """Rename tmp/final into place; an earlier odo-import output (marker checked) is replaced."""
+    if out.exists():
+        old = out.with_name(out.name + f".old.{os.getpid()}")
+        out.rename(old)
+        (tmp / "final").rename(out)
+        shutil.rmtree(old)
+    else:
+        (tmp / "final").rename(out)
+    shutil.rmtree(tmp)
+
+
+def rosbag_doc() -> str:
+    from . import rosbag_import
+
+    return rosbag_import.__doc__ or ""
+
+
+def import_bags(a: argparse.Namespace, dst: Path) -> None:
+    """One run per bag, written like ticks-csv's (the wheel joints in rad, cumulative)."""
+    from .rosbag_import import read_bag
+
+    robot = read_robot(a.robot)
+    joints = tuple(j.strip() for j in a.joints.split(","))
+    if len(joints) != 2 or not all(joints):
+        raise ValueError("--joints: give LEFT,RIGHT")
+    dirs = a.directions.split(",") if a.directions else ["fwd"] * len(a.bag)
+    if len(dirs) != len(a.bag):
+        raise ValueError(f"--directions has {len(dirs)} entries for {len(a.bag)} bags")
+    dst.mkdir()
+    seen: dict[str, int] = {}
+    rets = []
+    for i, bag in enumerate(a.bag):
+        d = dirs[i]
+        seen[d] = seen.get(d, 0) + 1
+        base = dst / f"run-{d}-{seen[d]:02d}"
+        tb, tt = read_bag(Path(bag), a.joint_topic, joints, a.truth_topic, robot.tick_s)
+        calc = write_run(
+            tb,
+            tt,
+            Path(a.robot),
+            base,
+            f"{bag} {a.joint_topic}",
+            f"{bag} {a.truth_topic}",
+            True,
+            "m,rad",
+            "rad",
+            "--joints",
+        )
+        if calc is not None:
+            x, y, th = returns_row(base.with_suffix(".truth.csv"))
+            cx, cy, cth = calc
+            cth = (cth + 180.0) % 360.0 - 180.0
+            rets.append(f"{seen[d]},{d},{x:.3f},{y:.3f},{th:.4f},{cx:.3f},{cy:.3f},{cth:.4f}")
+        print(f"odo-import: {bag} -> {base.name}", file=sys.stderr)
+    if rets:
+        (dst / "returns.csv").write_text(RET_HEADER + "\n".join(rets) + "\n")
+    shutil.copy(a.robot, dst / "robot.json")
+    (dst / MARKER).write_text("written by odo-import; it replaces this folder on a re-import\n")
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(
         prog="odo-import", description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
@@ -350,17 +446,38 @@ def main(argv: list[str] | None = None) -> int:
     t.add_argument("--cumulative", action="store_true", help="ticks are running totals")
     t.add_argument("--directions", help="comma list of run directions (cw/ccw/fwd), one per run")
     t.add_argument("--out", required=True, help="new folder (several input folders: one each)")
+    b = sub.add_parser(
+        "ros2-bag",
+        help="ROS 2 bags (JointState wheels + Odometry/PoseStamped truth) -> candump + truth CSV",
+        description=rosbag_doc(),
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    b.add_argument("--bag", required=True, nargs="+", help="one bag (folder or .mcap/.db3) per run")
+    b.add_argument("--robot", required=True)
+    b.add_argument("--joint-topic", default="/joint_states", help="JointState topic")
+    b.add_argument(
+        "--joints", required=True, help="LEFT,RIGHT wheel joint names, e.g. wheel_left,wheel_right"
+    )
+    b.add_argument("--truth-topic", help="nav_msgs/Odometry or geometry_msgs/PoseStamped topic")
+    b.add_argument("--directions", help="comma list of run directions (cw/ccw/fwd), one per run")
+    b.add_argument("--out", required=True, help="new folder")
     a = ap.parse_args(argv)
     out = Path(a.out)
     tmp = out.with_name(out.name + f".tmp.{os.getpid()}")
     try:
-        inputs = [Path(p).resolve() for p in a.ticks + (a.truth or []) + [a.robot]]
+        srcs = a.ticks + (a.truth or []) if a.cmd == "ticks-csv" else a.bag
+        inputs = [Path(p).resolve() for p in [*srcs, a.robot]]
         if out.resolve() in inputs or any(out.resolve() in p.parents for p in inputs):
             raise GapInputError(out, "--out is (or holds) an input; choose a new folder")
         if out.exists() and not (out / MARKER).is_file():
             raise GapInputError(
                 out, "exists and was not written by odo-import; choose a new folder"
             )
+        if a.cmd == "ros2-bag":
+            tmp.mkdir(parents=True)
+            import_bags(a, tmp / "final")
+            finish(out, tmp)
+            return 0
         if a.map and a.columns:
             ap.error("--map names header columns, --columns header-less ones: give one")
         sets = expand(a.ticks)
@@ -376,14 +493,7 @@ def main(argv: list[str] | None = None) -> int:
             for name, files in sets:
                 import_set(a, files, None, tmp / "final" / (name or "files"))
             (tmp / "final" / MARKER).write_text("written by odo-import\n")
-        if out.exists():  # an earlier odo-import output (marker checked above)
-            old = out.with_name(out.name + f".old.{os.getpid()}")
-            out.rename(old)
-            (tmp / "final").rename(out)
-            shutil.rmtree(old)
-        else:
-            (tmp / "final").rename(out)
-        shutil.rmtree(tmp)
+        finish(out, tmp)
         return 0
     except GapInputError as e:
         shutil.rmtree(tmp, ignore_errors=True)
