@@ -134,7 +134,7 @@ START_TEST(reader_names_file_and_line)
     char path[64];
     snprintf(path, sizeof path, "/tmp/odo-test-log-%ld.log", (long)getpid());
     write_file(path, "(0.000000) can0 110#0000000000000000\n\n(0.040000) can0 111#0000000000000000\n"
-                     "(0.080000) can0 120##0000\n(0.120000) can0 121#000000000000\n(0.16) can0 12#00\n");
+                     "(0.080000) can0 120##10011\n(0.120000) can0 121#000000000000\n(0.16) can0 12#00\n");
     static hal_log_t l;
     ck_assert_int_eq(hal_log_open(&l, path), 0);
     candump_line_t line;

@@ -602,7 +602,7 @@ static void test_load_falls_back_to_exactly_the_defaults_and_reports_why(void)
         {"version", 4, 0x03, true, ODO_PARAMS_SIZE, ODO_PARAMS_ERR_VERSION},
         {"length", 6, 0x01, true, ODO_PARAMS_SIZE, ODO_PARAMS_ERR_LENGTH},
         {"crc", 40, 0x10, false, ODO_PARAMS_SIZE, ODO_PARAMS_ERR_CRC},
-        {"range", 9, 0x01, true, ODO_PARAMS_SIZE, ODO_PARAMS_ERR_RANGE},
+        {"range", 9, 0x40, true, ODO_PARAMS_SIZE, ODO_PARAMS_ERR_RANGE}, /* counter_bits 24 -> 88 */
         {"reserved", 101, 0x01, true, ODO_PARAMS_SIZE, ODO_PARAMS_ERR_RANGE},
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
