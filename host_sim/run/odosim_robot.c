@@ -19,7 +19,15 @@ char *odosim_robot_describe(const char *robot_path, char *err, size_t errlen)
         snprintf(err, errlen, "out of memory");
         return NULL;
     }
-    if (sim_robot_parse_file(robot_path, r, err, errlen) != 0 || sim_robot_to_params(r, &p, err, errlen) != 0) {
+    if (sim_robot_parse_file(robot_path, r, err, errlen) != 0) {
+        free(r);
+        return NULL;
+    }
+    if (sim_robot_to_params(r, &p, err, errlen) != 0) {
+        /* "robot: <field>: <why>" -> "<path>: <field>: <why>", as the parser's messages read */
+        char tmp[1024];
+        snprintf(tmp, sizeof tmp, "%s", strncmp(err, "robot: ", 7) == 0 ? err + 7 : err);
+        snprintf(err, errlen, "%s: %s", robot_path, tmp);
         free(r);
         return NULL;
     }

@@ -1,6 +1,8 @@
 /// Robot description JSON reader and conversion to odo_params_t; see robot.h for the schema.
 #include "robot.h"
 
+#include "odo/odo_odometry.h"
+
 #include <errno.h>
 #include <jansson.h>
 #include <math.h>
@@ -623,6 +625,29 @@ int sim_robot_to_params(const sim_robot_t *r, odo_params_t *p, char *err, size_t
         snprintf(f, sizeof f, "%s%s%s", truck_field ? "trucks." : "",
                  truck_field ? (bad_truck == 0U ? "A." : "B.") : "", json_field(r, bad));
         return fail(&c, f, "rejected by odo_params_validate (parameter block field %d out of range)", (int)bad);
+    }
+    /* A block that validates must also boot: the firmware's per-truck multipliers must fit, and a
+     * counter must not wrap within one tick at the top wheel speed (odo_model_init). */
+    for (unsigned t = 0; t < r->n_trucks && t < ODO_TRUCKS; ++t) {
+        odo_model_t m;
+        if (odo_model_init(&m, &p->truck[t], p->counter_bits, p->heading_form, p->tick_us,
+                           p->max_wheel_speed_mm_s) != ODO_MODEL_OK) {
+            const sim_truck_desc_t *d = &r->truck[t];
+            const double per_tick = r->max_wheel_speed_mm_s * r->tick_ms * 1e-3 /
+                                    (M_PI * d->wheel_diameter_mm / sim_robot_counts_per_rev(d));
+            char f[64];
+            if (per_tick + 1.0 >= ldexp(1.0, (int)d->counter_bits - 1)) {
+                snprintf(f, sizeof f, "trucks.%c.counter_bits", t == 0U ? 'A' : 'B');
+                return fail(&c, f, "%u-bit counters wrap within one %g ms tick at max_wheel_speed_mm_s %g "
+                            "(%.0f counts per tick; the firmware needs fewer than %.0f)", d->counter_bits,
+                            r->tick_ms, r->max_wheel_speed_mm_s, per_tick, ldexp(1.0, (int)d->counter_bits - 1));
+            }
+            const double turns = 2.0 * r->max_wheel_speed_mm_s * r->tick_ms * 1e-3 / d->wheelbase_mm / (2.0 * M_PI);
+            snprintf(f, sizeof f, "trucks.%c", t == 0U ? 'A' : 'B');
+            return fail(&c, f, "geometry beyond the firmware's fixed-point formats (odo_model_init): at "
+                        "max_wheel_speed_mm_s %g a %g ms tick may turn %.3g turns with wheelbase_mm %g",
+                        r->max_wheel_speed_mm_s, r->tick_ms, turns, d->wheelbase_mm);
+        }
     }
     return 0;
 }

@@ -97,19 +97,68 @@ def calib(*args: str) -> subprocess.CompletedProcess:
 
 # --- one robot contract ---------------------------------------------------------------------
 
-@pytest.mark.parametrize("key,bad,good", [("wheel_diameter_mm", 5, 10), ("counter_bits", 7, 8),
+@pytest.mark.parametrize("key,bad,good", [("wheel_diameter_mm", 5, 10), ("counter_bits", 7, 12),
                                           ("counter_bits", 33, 32), ("wheelbase_mm", 3001, 3000)])
 def test_python_and_c_share_one_validator(tmp_path: Path, key: str, bad, good) -> None:
     """Python keeps no limits: read_robot and the C CLI give the same verdict and message."""
-    ok = robot_file(tmp_path, **{key: good})
+    wide = {"counter_bits": 24} if key != "counter_bits" else {}
+    ok = robot_file(tmp_path, **{**wide, key: good})
     assert read_robot(ok).trucks[0][key] == good
-    b = robot_file(tmp_path, **{key: bad})
+    b = robot_file(tmp_path, **{**wide, key: bad})
     with pytest.raises(GapInputError) as e:
         read_robot(b)
     r = calib("fit", "--runs", str(tmp_path), "--robot", str(b))
     assert r.returncode == 1
     assert f"trucks.A.{key}" in str(e.value) and f"trucks.A.{key}" in r.stderr
     assert str(e.value).split(key)[1] in r.stderr
+
+
+def test_every_truck_limit_of_the_c_table_holds_in_python(tmp_path: Path) -> None:
+    """The table itself (odosim_robot_limits_json): each truck key's bounds are accepted and a
+    step outside is refused by read_robot, so Python cannot hold other limits."""
+    import ctypes as C
+
+    from odo_tools.gap.simlib import lib
+
+    so = lib()
+    so.odosim_robot_limits_json.restype = C.c_void_p
+    ptr = so.odosim_robot_limits_json()
+    rows = json.loads(C.string_at(ptr).decode())
+    so.odosim_free(ptr)
+    keys = {r["key"] for r in rows}
+    assert {"trucks.*.wheel_diameter_mm", "trucks.*.counter_bits", "tick_ms"} <= keys
+    for r in rows:
+        if not r["key"].startswith("trucks.*.") or ".calibration." in r["key"]:
+            continue
+        k = r["key"].split(".")[-1]
+        if k in ("encoder_lines", "gear_ratio"):
+            continue  # bounded jointly by counts per turn as well
+        integer = k == "counter_bits"
+        for v, ok in ((r["lo"], True), (r["hi"], True), (r["lo"] - 1, False), (r["hi"] + 1, False)):
+            v = int(v) if integer else v
+            if k == "counter_bits" and ok and v < 12:
+                continue  # narrower counters cannot hold this robot's counts per 50 ms cycle
+            wide = {"counter_bits": 32} if k != "counter_bits" else {}
+            f = robot_file(tmp_path, **{**wide, k: v})
+            if ok and k == "wheelbase_mm" and v == r["lo"]:
+                # 50 mm at 3 m/s: 6 rad a tick, beyond the firmware's formats: refused
+                with pytest.raises(GapInputError, match="fixed-point formats"):
+                    read_robot(f)
+            elif ok:
+                assert read_robot(f).trucks[0][k] == v, (k, v)
+            else:
+                with pytest.raises(GapInputError, match=k):
+                    read_robot(f)
+
+
+def test_a_counter_that_wraps_within_a_tick_is_refused_by_both(tmp_path: Path) -> None:
+    """8 bits is a legal width, but this robot moves 1589 counts per 50 ms at 3 m/s: the
+    firmware could not tell the direction of a wrap, so the one validator says so."""
+    b = robot_file(tmp_path, counter_bits=8)
+    with pytest.raises(GapInputError, match=r"8-bit counters wrap within one 50 ms tick"):
+        read_robot(b)
+    r = calib("fit", "--runs", str(tmp_path), "--robot", str(b))
+    assert r.returncode == 1 and "8-bit counters wrap within one 50 ms tick" in r.stderr
 
 
 def test_python_io_has_no_numeric_limits_of_its_own() -> None:
