@@ -239,6 +239,7 @@ def test_header_map_radians_and_firmware_columns(tmp_path: Path) -> None:
     ("time_backwards", ":5: time"),
     ("length_mismatch", "mismatched ticks/truth lengths"),
     ("other_robot_cycle", "cycle 100.0 ms"),
+    ("running_totals_as_increments", "faster than the robot's max_wheel_speed_mm_s"),
     ("out_is_input", "is (or holds) an input"),
     ("out_not_ours", "was not written by odo-import"),
 ])
@@ -266,6 +267,9 @@ def test_import_bad_input(tmp_path: Path, case: str, expect: str) -> None:
         f.write_text("t_s" + "\n".join(
             [ln if i == 0 else f"{i * 0.1:.3f}" + ln[ln.index(","):]
              for i, ln in enumerate(f.read_text().splitlines())])[3:] + "\n")
+    elif case == "running_totals_as_increments":
+        cum = np.cumsum(ticks, axis=0)
+        write_run(f, cum, truth)   # running totals, imported without --cumulative
     elif case == "out_is_input":
         out = f.parent
     elif case == "out_not_ours":

@@ -237,7 +237,7 @@ def write_run(
     for w in ("left", "right"):
         cum = to_counts(tb[w], ticks_unit, robot, cumulative or ticks_unit != "counts")
         step = np.abs(np.diff(cum))
-        lim = robot.raw.get("max_wheel_speed_mm_s", 3000) * robot.tick_s / robot.mm_per_count(0)
+        lim = robot.described["max_wheel_speed_mm_s"] * robot.tick_s / robot.mm_per_count(0)
         if step.size and step.max() > lim:
             i = int(np.argmax(step > lim)) + 2
             raise GapInputError(

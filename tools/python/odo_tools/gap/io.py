@@ -86,6 +86,7 @@ class Robot:
     linkage: dict = field(default_factory=dict)
     trailer: dict = field(default_factory=dict)
     raw: dict = field(default_factory=dict)
+    described: dict = field(default_factory=dict)  # odosim_robot_describe: what the C parser read
 
     def mm_per_count(self, t: int) -> float:
         d = self.trucks[t]
@@ -135,7 +136,7 @@ def read_robot(path: str | Path) -> Robot:
         }
         for t in doc["trucks"]
     ]
-    r = Robot(str(path), doc["vehicle"], doc["tick_ms"] / 1000.0, trucks, raw=raw)
+    r = Robot(str(path), doc["vehicle"], doc["tick_ms"] / 1000.0, trucks, raw=raw, described=doc)
     if "linkage" in doc:
         lk = doc["linkage"]
         r.linkage = {
