@@ -50,6 +50,7 @@ char *odosim_robot_describe(const char *robot_path, char *err, size_t errlen)
         json_object_set_new(j, "ed", json_real(d->cal_ed));
         json_object_set_new(j, "eb", json_real(d->cal_eb));
         json_object_set_new(j, "es", json_real(d->cal_es));
+        json_object_set_new(j, "scrub", json_real(d->cal_scrub));
         json_array_append_new(trucks, j);
     }
     json_object_set_new(o, "trucks", trucks);

@@ -195,12 +195,8 @@ int calib_fit_main(int argc, char **argv)
         fit_data_free(&set);
         return 1;
     }
-    fit_params_t in_block;
+    fit_params_t in_block; /* the model as the block holds it (Q30) */
     fit_params_from_truck(&pb.truck[0], &in_block);
-    const bool block_has_k = false; /* the block carries scrub from version 2 (fw-params) */
-    if (block_has_k) {
-        in_block.k = res.p.k;
-    }
 
     /* Firmware replay of the block vs the double model of the same block, every run. */
     double fw_max = 0.0;
@@ -265,9 +261,8 @@ int calib_fit_main(int argc, char **argv)
                res.p.es, res.p.k);
         printf(" \"sd\": {\"ed\": %.3g, \"eb\": %.3g, \"es\": %.3g, \"scrub\": %.3g},\n", res.sd.ed, res.sd.eb, res.sd.es,
                res.sd.k);
-        printf(" \"fitted\": {\"ed\": %s, \"eb\": %s, \"es\": %s, \"scrub\": %s}, \"block_carries_scrub\": %s,\n",
-               fr.ed ? "true" : "false", fr.eb ? "true" : "false", res.es_free ? "true" : "false",
-               res.k_free ? "true" : "false", block_has_k ? "true" : "false");
+        printf(" \"fitted\": {\"ed\": %s, \"eb\": %s, \"es\": %s, \"scrub\": %s},\n", fr.ed ? "true" : "false",
+               fr.eb ? "true" : "false", res.es_free ? "true" : "false", res.k_free ? "true" : "false");
         printf(" \"rms_mm\": %.4f, \"residuals\": %zu, \"iterations\": %d,\n \"rig\": {", res.rms_mm, res.n_residuals,
                res.iterations);
         for (size_t g = 0; g < set.n_groups; ++g) {
@@ -325,8 +320,7 @@ int calib_fit_main(int argc, char **argv)
         printf("  Eb    %.6f  (formal sd %.1e)%s\n", res.p.eb, res.sd.eb, fr.eb ? "" : "  fixed");
         printf("  Es    %.6f  (formal sd %.1e)%s\n", res.p.es, res.sd.es,
                res.es_free ? "" : (fr.es ? "  fixed: no fitted track (closed paths do not show the scale)" : "  fixed"));
-        printf("  scrub %.6f  (formal sd %.1e)%s%s\n", res.p.k, res.sd.k, res.k_free ? "" : "  fixed",
-               block_has_k ? "" : "  (not in this block version: the firmware does not apply it)");
+        printf("  scrub %.6f  (formal sd %.1e)%s\n", res.p.k, res.sd.k, res.k_free ? "" : "  fixed");
         for (size_t g = 0; g < set.n_groups; ++g) {
             if (res.rig[g].fitted) {
                 printf("  rig %-16s lever arm (%.2f, %.2f) mm, heading offset %.3f deg (nuisance)\n", set.group_name[g],

@@ -21,8 +21,7 @@ void fit_params_to_truck(const fit_params_t *p, odo_truck_params_t *t)
     t->ed_q30 = q30(p->ed);
     t->eb_q30 = q30(p->eb);
     t->es_q30 = q30(p->es);
-    /* The scrub term joins the block with its version 2 (branch fw-params): until then a block
-     * cannot carry k and the caller reports k separately. */
+    t->scrub_q30 = q30(p->k);
 }
 
 void fit_params_from_truck(const odo_truck_params_t *t, fit_params_t *p)
@@ -30,18 +29,7 @@ void fit_params_from_truck(const odo_truck_params_t *t, fit_params_t *p)
     p->ed = odo_ref_q30(t->ed_q30);
     p->eb = odo_ref_q30(t->eb_q30);
     p->es = odo_ref_q30(t->es_q30);
-    p->k = 0.0;
-}
-
-/* The scrub factor (1 - k m / v) of one tick (fit_model.h). */
-static double scrub_factor(int32_t dl, int32_t dr, double k)
-{
-    const double al = fabs((double)dl), ar = fabs((double)dr), v = al + ar;
-    if (v <= 0.0 || k == 0.0) {
-        return 1.0;
-    }
-    const double m = ((dl > 0 && dr > 0) || (dl < 0 && dr < 0)) ? 2.0 * (al < ar ? al : ar) : 0.0;
-    return 1.0 - k * m / v;
+    p->k = odo_ref_q30(t->scrub_q30);
 }
 
 void fit_integrate(const fit_run_t *run, const odo_truck_params_t *base, unsigned heading_form, const fit_params_t *p,
@@ -50,13 +38,9 @@ void fit_integrate(const fit_run_t *run, const odo_truck_params_t *base, unsigne
     odo_truck_params_t tp = *base;
     fit_params_to_truck(p, &tp);
     odo_ref_t r;
-    odo_ref_init(&r, &tp, (uint8_t)heading_form, x0, y0, th0);
-    const double b_eff = r.b_eff_mm;
+    odo_ref_init(&r, &tp, (uint8_t)heading_form, x0, y0, th0); /* the scrub term included */
     for (size_t i = 0; i < run->n; ++i) {
         if (i > 0) {
-            /* odo_ref's heading change is (sR - sL) / b_eff; scaling it by the scrub factor is
-             * dividing b_eff by it for this tick. */
-            r.b_eff_mm = b_eff / scrub_factor(run->delta[i][0], run->delta[i][1], p->k);
             odo_ref_step(&r, run->delta[i][0], run->delta[i][1]);
         }
         if (x != NULL) x[i] = r.x_mm;
@@ -167,9 +151,7 @@ void fit_return_error(const fit_run_t *run, const odo_truck_params_t *base, unsi
         fit_params_to_truck(p, &tp);
         odo_ref_t r;
         odo_ref_init(&r, &tp, (uint8_t)heading_form, 0.0, 0.0, 0.0);
-        const double b_eff = r.b_eff_mm;
         for (size_t i = 1; i < run->n; ++i) {
-            r.b_eff_mm = b_eff / scrub_factor(run->delta[i][0], run->delta[i][1], p->k);
             odo_ref_step(&r, run->delta[i][0], run->delta[i][1]);
         }
         x = r.x_mm;

@@ -83,7 +83,7 @@ int fit_run_fit(const fit_set_t *s, const odo_truck_params_t *base, unsigned hea
 void fit_return_error(const fit_run_t *run, const odo_truck_params_t *base, unsigned heading_form,
                       const fit_params_t *p, const fit_rig_t *rig, fit_return_err_t *e);
 
-/// Parameters as a block's truck (Q30, rounded); the scrub term when the block carries one.
+/// Parameters as a block's truck (Q30, rounded: ed, eb, es and scrub).
 void fit_params_to_truck(const fit_params_t *p, odo_truck_params_t *t);
 
 /// The block's truck as parameters.

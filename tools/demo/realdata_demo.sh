@@ -24,7 +24,7 @@ SQ=$OUT/import/square-230620202042 CI=$OUT/import/circular-250620202104
 "$BIN/odo-calib" fit --runs "$SQ" "$CI" --robot "$ROBOT" \
   --fit 'square*/run-*-0[12]' 'circ*/run-cw-0[12]' 'circ*/run-ccw-01' \
   --out-params "$OUT/optiodom.json" "$OUT/optiodom.bin" 2>/dev/null | tee "$OUT/fit.txt"
-if [ ! -f build/cm4/bin/odo_image.elf ] && command -v arm-none-eabi-gcc >/dev/null; then
+if command -v arm-none-eabi-gcc >/dev/null; then   # incremental: the image of this firmware
   cmake --preset cm4 >/dev/null && cmake --build --preset cm4 -j 2 >/dev/null
 fi
 PARAMS_AFTER="$OUT/optiodom.json"
