@@ -328,8 +328,9 @@ def test_fit_recovers_a_robot_it_did_not_make(synthetic, tmp_path: Path) -> None
             assert g["pos_factor"] > 5 and g["heading_factor"] > 5
     assert doc["firmware_vs_double_max_mm"] < 0.1
     blk = json.loads(out.read_text())
-    assert blk["truck"][0]["eb_q30"] == round(p["eb"] * 2**30)
-    assert blk["truck"][0]["scrub_q30"] == round(p["scrub"] * 2**30)   # block v2 carries k
+    # the block holds the fitted values in Q30 (the JSON report prints 9 decimals: +-1 LSB)
+    assert abs(blk["truck"][0]["eb_q30"] - p["eb"] * 2**30) <= 1
+    assert abs(blk["truck"][0]["scrub_q30"] - p["scrub"] * 2**30) <= 1   # block v2 carries k
     raw = (tmp_path / "p.bin").read_bytes()   # the block: 'ODOP', version, its own length
     assert raw[:4] == b"ODOP" and int.from_bytes(raw[6:8], "little") == len(raw)
 
