@@ -91,8 +91,8 @@ odo_model_status_t odo_model_init(odo_model_t *m, const odo_truck_params_t *tp, 
             return ODO_MODEL_ERR_RANGE;
         }
     }
-    /* k * turn per count for the scrub term; |k| <= 1/4, so each stays below 2^60 and a product
-     * with a delta below 2^62 in magnitude, like the heading's own. */
+    /* k * turn per count for the scrub term. turn * max_counts < 2^62 (checked above) and
+     * |k| <= 1/4, so k * turn * |delta| stays below 2^60 for every accepted delta. */
     for (unsigned w = 0U; w < 2U; ++w) {
         mm.scrub_turn_q64[w] = (uint64_t)odo_mul_s64_s32_shr((int64_t)mm.turn_q64[w], tp->scrub_q30, 30U);
     }

@@ -25,7 +25,7 @@
 #define MEMBER_SIZE_TRUCK(m) sizeof(((const odo_truck_params_t *)0)->m)
 
 #define FIELD_ROW(id, scope, member, json, since, off, stride, type, lo, hi, unit)                   \
-    {json, (int64_t)(lo), (int64_t)(hi), (uint16_t)(off), (uint16_t)(stride),                       \
+    {(int64_t)(lo), (int64_t)(hi), json, (uint16_t)(off), (uint16_t)(stride),                       \
      (uint16_t)MEMBER_OFF_##scope(member), (uint8_t)ODO_PF_##id, (uint8_t)ODO_PSCOPE_##scope,        \
      (uint8_t)ODO_PTYPE_##type, (uint8_t)WIDTH_##type, (uint8_t)(since)},
 

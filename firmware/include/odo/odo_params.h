@@ -221,9 +221,9 @@ typedef enum { ODO_PTYPE_U8 = 0, ODO_PTYPE_U16 = 1, ODO_PTYPE_U32 = 2, ODO_PTYPE
 
 /// One row of ODO_PARAMS_FIELDS as data, for code that walks the fields (codec, JSON, tools).
 typedef struct {
-    const char *name;   ///< `json`: odo_params_field_name of this field
     int64_t     min;    ///< inclusive range
     int64_t     max;
+    const char *name;   ///< `json`: odo_params_field_name of this field
     uint16_t    offset; ///< byte offset in the block (truck fields: truck A's)
     uint16_t    stride; ///< truck fields: truck B's offset minus truck A's; otherwise 0
     uint16_t    member; ///< offsetof the member in odo_truck_params_t (TRUCK) or odo_params_t
