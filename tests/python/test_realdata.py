@@ -240,6 +240,8 @@ def test_header_map_radians_and_firmware_columns(tmp_path: Path) -> None:
     ("length_mismatch", "mismatched ticks/truth lengths"),
     ("other_robot_cycle", "cycle 100.0 ms"),
     ("running_totals_as_increments", "faster than the robot's max_wheel_speed_mm_s"),
+    ("not_a_number", ":7: not a number in column left"),
+    ("directions", "--directions has 2 entries for 1 runs"),
     ("out_is_input", "is (or holds) an input"),
     ("out_not_ours", "was not written by odo-import"),
 ])
@@ -270,6 +272,12 @@ def test_import_bad_input(tmp_path: Path, case: str, expect: str) -> None:
     elif case == "running_totals_as_increments":
         cum = np.cumsum(ticks, axis=0)
         write_run(f, cum, truth)   # running totals, imported without --cumulative
+    elif case == "not_a_number":
+        rows = f.read_text().splitlines()
+        rows[6] = ",".join([*rows[6].split(",")[:-1], "n/a"])
+        f.write_text("\n".join(rows) + "\n")
+    elif case == "directions":
+        args += ["--directions", "cw,ccw"]
     elif case == "out_is_input":
         out = f.parent
     elif case == "out_not_ours":
@@ -278,7 +286,7 @@ def test_import_bad_input(tmp_path: Path, case: str, expect: str) -> None:
     r = odo_import("ticks-csv", "--ticks", str(f), *args, "--robot", str(robot), "--out", str(out))
     assert r.returncode == 1, r.stderr
     assert expect in r.stderr and "Traceback" not in r.stderr
-    assert str(f) in r.stderr or str(out) in r.stderr or "truth.csv" in r.stderr
+    assert str(f.parent) in r.stderr or str(out) in r.stderr or "truth.csv" in r.stderr
     if case == "out_not_ours":
         assert (out / "mine.txt").read_text() == "user data"
     elif case != "out_is_input":
@@ -288,17 +296,15 @@ def test_import_bad_input(tmp_path: Path, case: str, expect: str) -> None:
 
 # --- odo-calib fit -----------------------------------------------------------------------------
 
-@pytest.fixture(scope="module")
-def synthetic(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
-    """Two sessions (squares, circles) of a robot with Ed 0.998, Eb 1.012, scrub 0.02 and a
-    marker 30 mm ahead, 10 mm left of the axle centre; imported with odo-import."""
-    tmp = tmp_path_factory.mktemp("syn")
+def make_set(tmp: Path, lever: tuple[float, float]) -> tuple[Path, Path]:
+    """Two sessions (squares, circles) of a robot with Ed 0.998, Eb 1.012, scrub 0.02 and the
+    tracked point at `lever` from the axle centre; imported with odo-import."""
     robot = robot_file(tmp)
     for shape in ("square", "circle"):
         d = tmp / "raw" / shape
         d.mkdir(parents=True)
         for i in range(4):
-            tk, tr = drive(shape, ed=0.998, eb=1.012, k=0.02, lever=(30.0, 10.0), seed=10 + i,
+            tk, tr = drive(shape, ed=0.998, eb=1.012, k=0.02, lever=lever, seed=10 + i,
                            ccw=bool(i % 2))
             write_run(d / f"run-{i + 1:02d}.csv", tk, tr)
     r = odo_import("ticks-csv", "--ticks", str(tmp / "raw/square"), str(tmp / "raw/circle"),
@@ -306,6 +312,12 @@ def synthetic(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
                    str(tmp / "imp"))
     assert r.returncode == 0, r.stderr
     return tmp / "imp", robot
+
+
+@pytest.fixture(scope="module")
+def synthetic(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
+    """The set with a marker 30 mm ahead, 10 mm left of the axle centre."""
+    return make_set(tmp_path_factory.mktemp("syn"), (30.0, 10.0))
 
 
 def test_fit_recovers_a_robot_it_did_not_make(synthetic, tmp_path: Path) -> None:
@@ -333,6 +345,24 @@ def test_fit_recovers_a_robot_it_did_not_make(synthetic, tmp_path: Path) -> None
     assert abs(blk["truck"][0]["scrub_q30"] - p["scrub"] * 2**30) <= 1   # block v2 carries k
     raw = (tmp_path / "p.bin").read_bytes()   # the block: 'ODOP', version, its own length
     assert raw[:4] == b"ODOP" and int.from_bytes(raw[6:8], "little") == len(raw)
+
+
+def test_fit_from_return_poses_only(tmp_path: Path) -> None:
+    """Without tracks (tape and protractor at the end of each run): Ed, Eb and scrub from the
+    return poses of squares and circles; Es stays fixed (closed paths do not show the scale)."""
+    imp, robot = make_set(tmp_path, (0.0, 0.0))   # return poses are the axle centre's
+    for f in imp.glob("*/*.truth.csv"):
+        f.unlink()
+    r = calib("fit", "--runs", str(imp / "square"), str(imp / "circle"), "--robot",
+              str(robot), "--fit", "*/run-*-01", "--json")
+    assert r.returncode == 0, r.stderr
+    doc = json.loads(r.stdout)
+    p = doc["params"]
+    assert not doc["fitted"]["es"] and p["es"] == 1.0
+    assert p["ed"] == pytest.approx(0.998, abs=5e-4)
+    assert p["eb"] == pytest.approx(1.012, abs=2e-3)
+    assert p["scrub"] == pytest.approx(0.02, abs=5e-3)
+    assert all(x["truth"] == "return" for x in doc["runs"])
 
 
 @pytest.mark.parametrize("case,expect", [
@@ -467,14 +497,16 @@ def test_ros2_bag_imports_wheels_and_truth(tmp_path: Path, truth_type: str) -> N
     (["--joint-topic", "/wheels"], "no topic /wheels"),
     (["--truth-topic", "/vicon"], "no topic /vicon"),
     (["--joints", "left,right"], "/joint_states: no joint left, right"),
+    (["--bag-path", "missing"], "cannot read as a ROS 2 bag"),
 ])
 def test_ros2_bag_without_the_named_topics(tmp_path: Path, args: list[str], expect: str) -> None:
     ticks, truth = drive("square", seed=4)
     make_bag(tmp_path / "bag", ticks[:60], truth[:60])
     base = {"--joints": "wheel_left,wheel_right", "--truth-topic": "/mocap/pose"}
     base.update(dict(zip(args[::2], args[1::2], strict=True)))
+    bag = tmp_path / base.pop("--bag-path", "bag")
     flat = [x for kv in base.items() for x in kv]
-    r = odo_import("ros2-bag", "--bag", str(tmp_path / "bag"), *flat, "--robot",
+    r = odo_import("ros2-bag", "--bag", str(bag), *flat, "--robot",
                    str(robot_file(tmp_path)), "--out", str(tmp_path / "o"))
-    assert r.returncode == 1 and expect in r.stderr and str(tmp_path / "bag") in r.stderr, r.stderr
+    assert r.returncode == 1 and expect in r.stderr and str(bag) in r.stderr, r.stderr
     assert "Traceback" not in r.stderr and not (tmp_path / "o").exists()
