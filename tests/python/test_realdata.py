@@ -370,6 +370,7 @@ def test_fit_from_return_poses_only(tmp_path: Path) -> None:
     ("glob", "'nothing*' matches no run"),
     ("backwards", "does not increase"),
     ("short_truth", "mismatched ticks/truth lengths"),
+    ("out_is_input", "is an input"),
 ])
 def test_fit_bad_input(synthetic, tmp_path: Path, case: str, expect: str) -> None:
     imp, robot = synthetic
@@ -390,9 +391,15 @@ def test_fit_bad_input(synthetic, tmp_path: Path, case: str, expect: str) -> Non
         tr = d / "run-cw-01.truth.csv"
         tr.write_text("\n".join(tr.read_text().splitlines()[:100]) + "\n")
     out = tmp_path / "p.json"
+    if case == "out_is_input":
+        out = d / "robot.json"
+        before = out.read_bytes()
     r = calib("fit", *args, "--out-params", str(out))
     assert r.returncode == 1 and expect in r.stderr, r.stderr
-    assert not out.exists()
+    if case == "out_is_input":
+        assert out.read_bytes() == before
+    else:
+        assert not out.exists()
 
 
 # --- the real robot ----------------------------------------------------------------------------

@@ -1,4 +1,5 @@
 /// `odo-calib fit`: calibrate from any runs with truth and judge on held-out runs (fit_model.h).
+#include <limits.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -58,6 +59,35 @@ static int take_list(int argc, char **argv, int *i, const char **dst, size_t *n,
     if (got == 0) {
         fprintf(stderr, "odo-calib fit: %s needs a value\n", name);
         return -1;
+    }
+    return 0;
+}
+
+/* Is `out` one of the inputs: the robot file, or a file a --runs folder holds that fit reads? */
+static int is_input(const char *out, const char *robot, const char *const *runs, size_t n_runs)
+{
+    char ro[PATH_MAX], rr[PATH_MAX], dir[PATH_MAX], rd[PATH_MAX], rdir[PATH_MAX];
+    if (realpath(robot, rr) != NULL && realpath(out, ro) != NULL && strcmp(ro, rr) == 0) {
+        return 1;
+    }
+    snprintf(dir, sizeof dir, "%s", out);
+    char *slash = strrchr(dir, '/');
+    const char *base = slash != NULL ? slash + 1 : out;
+    if (slash != NULL) {
+        *slash = '\0';
+    } else {
+        snprintf(dir, sizeof dir, ".");
+    }
+    if (realpath(dir, rd) == NULL) {
+        return 0;
+    }
+    const int read_by_fit = strcmp(base, "robot.json") == 0 || strcmp(base, "returns.csv") == 0 ||
+                            (strncmp(base, "run-", 4) == 0 && (strstr(base, ".log") != NULL ||
+                                                               strstr(base, ".truth.csv") != NULL));
+    for (size_t k = 0; k < n_runs && read_by_fit; ++k) {
+        if (realpath(runs[k], rdir) != NULL && strcmp(rdir, rd) == 0) {
+            return 1;
+        }
     }
     return 0;
 }
@@ -139,8 +169,9 @@ int calib_fit_main(int argc, char **argv)
             fprintf(stderr, "odo-calib fit: --out-params %s: name it .json or .bin\n", outs[k]);
             return 2;
         }
-        if (strcmp(outs[k], robot) == 0) {
-            fprintf(stderr, "odo-calib fit: --out-params %s is an input (the robot description)\n", outs[k]);
+        if (is_input(outs[k], robot, runs, n_runs)) {
+            fprintf(stderr, "odo-calib fit: --out-params %s is an input (the robot description or a file of "
+                            "a --runs folder)\n", outs[k]);
             return 1;
         }
     }
