@@ -134,7 +134,7 @@ int32_t odo_ipec_gain(uint8_t ipec_mode, int32_t innov_bam, uint8_t rotary_bits)
 void odo_ipec_step(const odo_params_t *p, const odo_ipec_reading_t *rd, odo_pose_t pose[2],
                    int64_t dist_mm_q40, odo_ipec_result_t *out);
 
-/// nm -> mm Q32 (exact to 2e-10 relative for |nm| up to 2^44; saturates beyond +-2^50 nm).
+/// nm -> mm Q32 (exact to 2e-10 relative; saturates beyond +-2.1e15 nm, where mm Q32 leaves int64).
 int64_t odo_ipec_nm_to_mm_q32(int64_t nm);
 
 #ifdef __cplusplus
