@@ -66,14 +66,14 @@ static int64_t apply_sign(uint64_t mag, bool negative)
     return (mag == 0U) ? 0 : -(int64_t)(mag - 1U) - 1;
 }
 
-/// Apply a sign to a magnitude of 64 + hi bits, saturating to INT64_MIN/INT64_MAX beyond int64.
-static int64_t apply_sign_sat(uint64_t hi, uint64_t mag, bool negative)
+/// Apply a sign to a magnitude of 64 + `over` bits, saturating to INT64_MIN/INT64_MAX beyond
+/// int64. The common case (over == 0, mag < 2^63) costs one test.
+static int64_t apply_sign_sat(uint64_t over, uint64_t mag, bool negative)
 {
-    const uint64_t limit = (uint64_t)INT64_MAX + (negative ? 1U : 0U);
-    if (hi != 0U || mag > limit) {
-        return negative ? INT64_MIN : INT64_MAX;
+    if ((over | (mag >> 63)) != 0U) {
+        return negative ? INT64_MIN : INT64_MAX; /* -2^63 itself lands on INT64_MIN exactly */
     }
-    return apply_sign(mag, negative);
+    return negative ? -(int64_t)mag : (int64_t)mag;
 }
 
 int64_t odo_mul_s64_s32_shr(int64_t a, int32_t b, unsigned shift)
@@ -88,25 +88,22 @@ int64_t odo_mul_s64_s32_shr(int64_t a, int32_t b, unsigned shift)
     uint64_t hi = (p_hi >> 32) + (lo < p_lo ? 1U : 0U);
     /* Round half away from zero on the magnitude: add half a unit of the result, then shift the
      * 96-bit value. Whatever stays in `hi` after the shift is beyond 64 bits: saturate. */
-    uint64_t mag;
-    if (shift == 0U) {
-        mag = lo;
-    } else if (shift < 64U) {
+    if (shift - 1U < 63U) { /* 1..63, every caller in the firmware */
         const uint64_t lo2 = lo + ((uint64_t)1U << (shift - 1U));
         hi += (lo2 < lo) ? 1U : 0U;
-        mag = (lo2 >> shift) | (hi << (64U - shift));
-        hi >>= shift;
-    } else if (shift < 96U) {
+        return apply_sign_sat(hi >> shift, (lo2 >> shift) | (hi << (64U - shift)), negative);
+    }
+    if (shift == 0U) {
+        return apply_sign_sat(hi, lo, negative);
+    }
+    if (shift < 96U) {
         /* The half unit sits in hi (or is lo's top bit); lo's other bits cannot carry into the
          * result: floor((H + f) / 2^s) == floor(H / 2^s) for an integer H and 0 <= f < 1. */
         const unsigned s = shift - 64U;
-        mag = (s == 0U) ? hi + (lo >> 63) : (hi + ((uint64_t)1U << (s - 1U))) >> s;
-        hi = 0U;
-    } else {
-        mag = 0U; /* |a * b| <= 2^94: below half a unit */
-        hi = 0U;
+        return apply_sign_sat(0U, (s == 0U) ? hi + (lo >> 63) : (hi + ((uint64_t)1U << (s - 1U))) >> s,
+                              negative);
     }
-    return apply_sign_sat(hi, mag, negative);
+    return 0; /* |a * b| <= 2^94: below half a unit */
 }
 
 int64_t odo_shr_round_s64(int64_t v, unsigned shift)

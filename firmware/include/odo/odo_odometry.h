@@ -27,6 +27,8 @@ typedef struct {
     int64_t  dist_mm_q40[2];  ///< distance per count, [ODO_LEFT, ODO_RIGHT]: cL/R * cm (Eq. 6.35)
     uint64_t turn_q64[2];     ///< heading change per count: dist / (2 pi b_eff) (Eq. 2.4), turns Q64
     uint32_t max_counts;      ///< largest believable |delta| per tick (from max_wheel_speed_mm_s)
+    uint32_t max_delta_counts;///< largest |delta| one step can integrate (k |delta| < 2^61 mm Q40
+                              ///< on both wheels; >= max_counts), for steps over a gap
     uint8_t  counter_bits;    ///< decoder counter width (16, 24, 32)
     uint8_t  invert;          ///< ODO_TRUCK_INVERT_* flags
     uint8_t  heading_form;    ///< odo_heading_form_t
@@ -44,7 +46,10 @@ typedef struct {
     int64_t  dist_mm_q40;  ///< centre-point displacement U_i (000 Eq. 2.3), mm Q40
     int64_t  dturn_q64;    ///< heading change dtheta_i (000 Eq. 2.4), signed turns Q64
     int32_t  delta[2];     ///< accepted count deltas, forward positive
-    bool     jump;         ///< a delta exceeded max_counts: nothing integrated, baseline re-taken
+    bool     jump;         ///< implausible or ambiguous reading (see odo_truck_step): nothing
+                           ///< integrated, baseline re-taken
+    bool     range;        ///< the pose is beyond ODO_POSE_LIMIT_MM_Q32 (odo_pose_in_range false);
+                           ///< if it already was, nothing was integrated (pose held)
 } odo_step_t;
 
 typedef enum {
@@ -64,28 +69,52 @@ odo_model_status_t odo_model_init(odo_model_t *m, const odo_truck_params_t *tp, 
                                   uint8_t heading_form, uint32_t tick_us,
                                   uint32_t max_wheel_speed_mm_s);
 
-/// Signed difference cur - prev of two raw counter readings modulo 2^bits (bits in [1, 32]),
-/// interpreted in [-2^(bits-1), 2^(bits-1)). Handles every wrap of a 16, 24 or 32-bit counter.
+/// Signed difference cur - prev of two raw counter readings modulo 2^bits, interpreted in
+/// [-2^(bits-1), 2^(bits-1)). Handles every wrap of a 16, 24 or 32-bit counter. bits above 32
+/// count as 32; bits 0 returns 0 (no information). Constant time.
 int32_t odo_count_delta(uint32_t prev, uint32_t cur, uint8_t bits);
+
+/// The odometry integrates from x and y in [-L, L), L = 2^61 mm Q32 = 2^29 mm (536.87 km). One
+/// step moves a pose by less than 2^54 mm Q32, so positions stay below 2^62 in magnitude and every
+/// difference of two positions (IPEC's link vector) fits int64. Beyond, odo_truck_step holds it.
+#define ODO_POSE_LIMIT_MM_Q32 ((int64_t)1 << 61)
+
+/// True iff x and y are both in [-ODO_POSE_LIMIT_MM_Q32, ODO_POSE_LIMIT_MM_Q32). Constant time.
+bool odo_pose_in_range(const odo_pose_t *p);
 
 /// Reset a truck to a pose; the next reading sets the counter baseline.
 void odo_truck_reset(odo_truck_t *t, const odo_pose_t *pose);
 
 /// One dead-reckoning step from raw counter readings (000 Eqs. 2.2-2.6).
-/// `bits` is the width the readings carry (a CAN frame carries 24); the modulus used is
-/// 2^min(bits, model counter_bits). On a jump (|delta| > max_counts on either wheel) the pose is
-/// not changed, the baseline is re-taken, and out->jump is true. Never fails otherwise.
+///   bits   the width the readings carry (a CAN frame carries 24); deltas are taken modulo 2^w,
+///          w = min(bits, the model's counter_bits).
+///   ticks  ticks elapsed since the previous reading (1: consecutive samples; 0 counts as 1).
+///          Counters are cumulative, so a reading after lost samples carries their motion, and
+///          the plausibility limit is max_counts * ticks.
+/// The first reading after odo_truck_reset only sets the baseline. out->jump is set, the pose is
+/// not changed and the baseline is re-taken when
+///   - |delta| > max_counts * ticks on either wheel (faster than max_wheel_speed_mm_s), or
+///     |delta| > max_delta_counts (a step too large to integrate), or
+///   - max_counts * ticks >= 2^(w-1): the wheel could have moved half the counter's range since
+///     the previous reading, so the modular delta is ambiguous whatever it reads (a gap too long
+///     for the counter width, or a w too narrow for one tick at the speed limit), or w == 0.
+/// out->range is set when the pose is beyond ODO_POSE_LIMIT_MM_Q32 after the step; a pose that was
+/// beyond it already is held (not integrated, baseline re-taken). A jump leaves out->range false.
+/// A heading change above half a turn in one step (a spin at speed over a long gap) is kept
+/// exactly modulo a turn, but its midpoint direction is then taken the short way round.
+/// Never fails otherwise. Constant time: no loop over the gap.
 void odo_truck_step(odo_truck_t *t, const odo_model_t *m, uint32_t left_raw, uint32_t right_raw,
-                    uint8_t bits, odo_step_t *out);
+                    uint8_t bits, uint32_t ticks, odo_step_t *out);
 
 /// Advance a pose by a centre displacement and heading change (000 Eqs. 2.5, 2.6), with the
 /// midpoint or the paper's heading form. Shared by odometry and IPEC re-integration.
 void odo_pose_advance(odo_pose_t *p, int64_t dist_mm_q40, int64_t dturn_q64, uint8_t heading_form);
 
 /// Conversions for output: heading as BAM (rounded), position in units of 10 um (rounded,
-/// saturating to int32).
+/// saturating to int32: +-21.47 km, the POSE_XY frame's range; *saturated, if not NULL, is set
+/// true when it saturated and left alone otherwise).
 uint32_t odo_heading_bam(const odo_pose_t *p);
-int32_t  odo_mm_q32_to_10um(int64_t v_mm_q32);
+int32_t  odo_mm_q32_to_10um(int64_t v_mm_q32, bool *saturated);
 
 #ifdef __cplusplus
 }
