@@ -19,9 +19,15 @@ odo_params_status_t replay_init(replay_t *r, const odo_params_t *p, replay_tick_
     return st;
 }
 
+/// Time of tick k (>= anchor_tick) on the log's clock.
+static uint64_t tick_time(const replay_t *r, uint64_t k)
+{
+    return r->anchor_us + (k - r->anchor_tick) * (uint64_t)r->tick_us;
+}
+
 static void step(replay_t *r)
 {
-    r->in.t_us = r->origin_us + r->cur * (uint64_t)r->tick_us;
+    r->in.t_us = tick_time(r, r->cur);
     odo_app_step(&r->app, &r->in, &r->out);
     r->stats.ticks++;
     if (r->fn != NULL) {
@@ -46,7 +52,7 @@ bool replay_deadline_us(const replay_t *r, uint64_t margin_us, uint64_t *deadlin
     if (!r->have_origin || !r->pending) {
         return false;
     }
-    *deadline_us = r->origin_us + r->cur * (uint64_t)r->tick_us + r->tick_us / 2U + margin_us;
+    *deadline_us = tick_time(r, r->cur) + r->tick_us / 2U + margin_us;
     return true;
 }
 
@@ -132,38 +138,66 @@ static void take(replay_t *r, const odo_can_frame_t *f)
     }
 }
 
+/// Move the tick clock's anchor to (t_us, the tick this frame opens): the open tick is closed
+/// first if it holds frames, so the frame starts a tick of its own.
+static void reanchor(replay_t *r, uint64_t t_us)
+{
+    if (r->pending) {
+        step(r);
+    }
+    r->anchor_us = t_us;
+    r->anchor_tick = r->cur;
+    r->last_t_us = t_us;
+}
+
+static uint64_t sat_add(uint64_t a, uint64_t b) { return a > UINT64_MAX - b ? UINT64_MAX : a + b; }
+
 void replay_push(replay_t *r, const odo_can_frame_t *f, uint64_t t_us)
 {
     r->stats.frames++;
     if (!r->have_origin) {
         r->have_origin = true;
         r->origin_us = t_us;
+        r->anchor_us = t_us;
+        r->anchor_tick = 0U;
         r->cur = 0U;
     }
-    uint64_t k = r->cur;
+    const uint64_t tick = r->tick_us;
+    const uint64_t half = tick / 2U;
     if (r->have_last && t_us < r->last_t_us) {
-        r->in.rx_faults |= ODO_FAULT_TIME_BACKWARDS;
         r->stats.time_backwards++;
-    } else {
-        /* k = round((t - t0) / tick). Most frames fall in the open tick: test its window first and
-         * divide only for a frame beyond it (a 64-bit division per frame is ~10 % of a replay). */
-        const uint64_t half = r->tick_us / 2U;
-        const uint64_t upper = r->origin_us + (r->cur + 1U) * (uint64_t)r->tick_us - half;
-        if (t_us < upper) {
-            const uint64_t lower = r->origin_us + r->cur * (uint64_t)r->tick_us; /* + half - half */
-            k = (r->cur > 0U && t_us + half < lower) ? 0U : r->cur; /* 0: any closed tick (late) */
-        } else {
-            k = (t_us - r->origin_us + half) / r->tick_us;
+        if (r->last_t_us - t_us > REPLAY_CLOCK_STEP_TICKS * tick) {
+            r->stats.clock_steps++;
+            reanchor(r, t_us); /* the clock stepped back: new ticks, not folded into the open one */
         }
-        if (k < r->cur) {
-            r->stats.late++;
+        r->in.rx_faults |= ODO_FAULT_TIME_BACKWARDS; /* reordered frames join the open tick */
+    } else {
+        /* Tick of t relative to the anchor (t >= last frame >= anchor). Most frames fall in the
+         * open tick: test its window first and divide only for a frame beyond it (a 64-bit
+         * division per frame is ~10 % of a replay). Differences only: any t_us is safe. */
+        const uint64_t d = t_us - r->anchor_us;
+        const uint64_t open = r->cur - r->anchor_tick;
+        uint64_t k = r->cur;
+        if (d >= open * tick + (tick - half)) { /* beyond the open tick's window */
+            const uint64_t q = d / tick;
+            k = r->anchor_tick + q + ((d - q * tick) >= tick - half ? 1U : 0U);
+        } else if (open > 0U && d + half < open * tick) {
+            r->stats.late++; /* a tick already closed (live): joins the open one */
+        }
+        if (k - r->cur > REPLAY_MAX_GAP_TICKS) {
+            const uint64_t gap = t_us - (r->have_last ? r->last_t_us : t_us);
+            r->stats.gaps++;
+            r->stats.gap_us = sat_add(r->stats.gap_us, gap);
+            r->stats.longest_gap_us = gap > r->stats.longest_gap_us ? gap : r->stats.longest_gap_us;
+            r->stats.last_gap_us = gap;
+            reanchor(r, t_us); /* reported and skipped: never ground through tick by tick */
             k = r->cur;
         }
         r->last_t_us = t_us;
         r->have_last = true;
-    }
-    while (r->cur < k) {
-        step(r); /* ticks without frames step too: the firmware flags what is missing */
+        while (r->cur < k) {
+            step(r); /* ticks without frames step too: the firmware flags what is missing */
+        }
     }
     take(r, f);
     r->pending = true;
