@@ -437,6 +437,23 @@ START_TEST(a_clock_stepping_back_two_seconds_is_re_anchored_not_folded)
     ck_assert_uint_eq(g_run_b.faults_or & (ODO_FAULT_COUNTER_JUMP_A | ODO_FAULT_COUNTER_JUMP_B), 0U);
     ck_assert_double_eq(max_dev(&g_run_b, 0), 0.0);
     ck_assert_double_eq(max_dev(&g_run_b, 1), 0.0);
+
+    /* the same step with every frame of tick 500 lost: the frames of 501 go to tick 501, as
+     * their sequence numbers say, and nothing shifts */
+    size_t m = 0;
+    for (size_t i = 0; i < n; ++i) {
+        if (g_clean[i].t_us / 40000U != 500U) {
+            fr[m++] = fr[i];
+        }
+    }
+    replay_frames(fr, m, &g_params[0], &g_run_b, &st);
+    report("clock 2 s back, tick 500 lost", &g_run_b);
+    ck_assert_uint_eq(st.clock_steps, 1U);
+    ck_assert_uint_eq(g_run_b.ticks, g_run_a.ticks);
+    ck_assert(g_run_b.status_faults[500] & ODO_FAULT_WHEEL_MISSING_A);
+    ck_assert(g_run_b.status_faults[501] & ODO_FAULT_TIME_BACKWARDS);
+    ck_assert_double_lt(end_dev(&g_run_b, 0), 1e-6); /* two ticks in one step: rounding only */
+    ck_assert_double_lt(max_dev(&g_run_b, 0), 20.0); /* tick 500 held: one tick's travel */
 }
 END_TEST
 

@@ -57,6 +57,33 @@ bool replay_deadline_us(const replay_t *r, uint64_t margin_us, uint64_t *deadlin
 }
 
 /// `seq` is a newer sample than `held` (1..127 ahead, modulo 256).
+/// The four consumed frames by identifier (what odo_can_classify would say, without its table
+/// walk: this runs for every frame of a replay); ODO_CAN_MSG_UNKNOWN for anything else.
+static odo_can_msg_t sensor_msg(const odo_can_frame_t *f)
+{
+    if (f->flags != 0U) {
+        return ODO_CAN_MSG_UNKNOWN;
+    }
+    switch (f->id) {
+    case ODO_CAN_ID_WHEEL_COUNTS_A: return ODO_CAN_MSG_WHEEL_COUNTS_A;
+    case ODO_CAN_ID_WHEEL_COUNTS_B: return ODO_CAN_MSG_WHEEL_COUNTS_B;
+    case ODO_CAN_ID_LINK_ROTARY: return ODO_CAN_MSG_LINK_ROTARY;
+    case ODO_CAN_ID_LINK_LINEAR: return ODO_CAN_MSG_LINK_LINEAR;
+    default: return ODO_CAN_MSG_UNKNOWN;
+    }
+}
+
+/// Sequence number of a sensor frame of the right length: byte 6 of WHEEL_COUNTS, byte 4 of the
+/// linkage frames (can/odometry.dbc). False for anything else.
+static bool sensor_seq(const odo_can_frame_t *f, odo_can_msg_t m, uint8_t *seq)
+{
+    if (m == ODO_CAN_MSG_UNKNOWN || f->dlc != odo_can_expected_dlc(m)) {
+        return false;
+    }
+    *seq = f->data[(m == ODO_CAN_MSG_WHEEL_COUNTS_A || m == ODO_CAN_MSG_WHEEL_COUNTS_B) ? 6U : 4U];
+    return true;
+}
+
 static bool newer(uint8_t held, uint8_t seq)
 {
     const uint8_t d = odo_can_seq_delta(held, seq);
@@ -72,18 +99,7 @@ static void take(replay_t *r, const odo_can_frame_t *f)
         r->stats.bus_off += (f->id & CAN_ERR_BUSOFF_CLASS) != 0U;
         return;
     }
-    /* The four consumed frames by identifier (what odo_can_classify would say, without its table
-     * walk: this runs for every frame of a replay). */
-    odo_can_msg_t m = ODO_CAN_MSG_UNKNOWN;
-    if (f->flags == 0U) {
-        switch (f->id) {
-        case ODO_CAN_ID_WHEEL_COUNTS_A: m = ODO_CAN_MSG_WHEEL_COUNTS_A; break;
-        case ODO_CAN_ID_WHEEL_COUNTS_B: m = ODO_CAN_MSG_WHEEL_COUNTS_B; break;
-        case ODO_CAN_ID_LINK_ROTARY: m = ODO_CAN_MSG_LINK_ROTARY; break;
-        case ODO_CAN_ID_LINK_LINEAR: m = ODO_CAN_MSG_LINK_LINEAR; break;
-        default: break;
-        }
-    }
+    const odo_can_msg_t m = sensor_msg(f);
     if (m == ODO_CAN_MSG_UNKNOWN) {
         r->stats.ignored++;
         return;
@@ -135,19 +151,44 @@ static void take(replay_t *r, const odo_can_frame_t *f)
         r->stats.dup_dropped++;
     } else {
         r->stats.sensor_frames++;
+        uint8_t seq = 0U;
+        (void)sensor_seq(f, m, &seq);
+        const unsigned i = (unsigned)m - (unsigned)ODO_CAN_MSG_WHEEL_COUNTS_A;
+        r->seq_known[i] = true;
+        r->seq_last[i] = seq;
+        r->seq_tick[i] = r->cur;
     }
 }
 
-/// Move the tick clock's anchor to (t_us, the tick this frame opens): the open tick is closed
-/// first if it holds frames, so the frame starts a tick of its own.
-static void reanchor(replay_t *r, uint64_t t_us)
+/// Move the tick clock's anchor to (t_us, tick k >= cur). The open tick is closed first unless k
+/// is the open tick itself, and the empty ticks before k are stepped (at most 127).
+static void reanchor(replay_t *r, uint64_t t_us, uint64_t k)
 {
-    if (r->pending) {
+    while (r->cur < k) {
         step(r);
     }
     r->anchor_us = t_us;
     r->anchor_tick = r->cur;
     r->last_t_us = t_us;
+}
+
+/// The tick a frame opens after the clock stepped back: its sensor's previous sample's tick plus
+/// the sequence step (1..127) if that is not in the past; otherwise the tick after the open one.
+static uint64_t tick_by_seq(const replay_t *r, const odo_can_frame_t *f)
+{
+    const uint64_t next = r->pending ? r->cur + 1U : r->cur;
+    const odo_can_msg_t m = sensor_msg(f);
+    uint8_t seq = 0U;
+    if (!sensor_seq(f, m, &seq)) {
+        return next;
+    }
+    const unsigned i = (unsigned)m - (unsigned)ODO_CAN_MSG_WHEEL_COUNTS_A;
+    const uint8_t d = odo_can_seq_delta(r->seq_last[i], seq);
+    if (!r->seq_known[i] || d == 0U || d >= 128U) {
+        return next;
+    }
+    const uint64_t k = r->seq_tick[i] + d;
+    return k >= r->cur ? k : next;
 }
 
 static uint64_t sat_add(uint64_t a, uint64_t b) { return a > UINT64_MAX - b ? UINT64_MAX : a + b; }
@@ -168,7 +209,8 @@ void replay_push(replay_t *r, const odo_can_frame_t *f, uint64_t t_us)
         r->stats.time_backwards++;
         if (r->last_t_us - t_us > REPLAY_CLOCK_STEP_TICKS * tick) {
             r->stats.clock_steps++;
-            reanchor(r, t_us); /* the clock stepped back: new ticks, not folded into the open one */
+            /* the clock stepped back: new ticks, not folded into the open one */
+            reanchor(r, t_us, tick_by_seq(r, f));
         }
         r->in.rx_faults |= ODO_FAULT_TIME_BACKWARDS; /* reordered frames join the open tick */
     } else {
@@ -190,7 +232,7 @@ void replay_push(replay_t *r, const odo_can_frame_t *f, uint64_t t_us)
             r->stats.gap_us = sat_add(r->stats.gap_us, gap);
             r->stats.longest_gap_us = gap > r->stats.longest_gap_us ? gap : r->stats.longest_gap_us;
             r->stats.last_gap_us = gap;
-            reanchor(r, t_us); /* reported and skipped: never ground through tick by tick */
+            reanchor(r, t_us, r->pending ? r->cur + 1U : r->cur); /* skipped, never ground through */
             k = r->cur;
         }
         r->last_t_us = t_us;

@@ -14,8 +14,10 @@
 /// Re-anchoring. Two things move the anchor (t0, tick 0) to (t, the tick the frame opens), so that
 /// tick k's input time is t + (k - that tick) * tick_us from then on:
 ///   - a frame stamped more than REPLAY_CLOCK_STEP_TICKS periods before the previous frame: the
-///     sender's clock stepped back. Its frames open the next tick instead of being folded into
-///     the open one (a 2 s step would otherwise fold 50 ticks into one);
+///     sender's clock stepped back. Its frames open new ticks instead of being folded into the
+///     open one (a 2 s step would otherwise fold 50 ticks into one): the tick its sequence number
+///     says (its sensor's previous sample's tick plus the step, 1..127, so a frame lost at the
+///     step shifts nothing), or else the tick after the open one;
 ///   - a frame more than REPLAY_MAX_GAP_TICKS periods after the open tick: a long gap in the log.
 ///     It is reported (stats.gaps, stats.gap_us) and skipped: the frame opens the next tick, the
 ///     empty ticks in between are never stepped (a 10^5 s gap would be 2.5 M of them).
@@ -100,6 +102,9 @@ typedef struct replay {
     bool              pending;    ///< the open tick has received a frame
     bool              have_last;
     uint64_t          last_t_us;  ///< timestamp of the previous frame
+    bool              seq_known[4]; ///< per sensor (WHEEL_COUNTS_A, _B, LINK_ROTARY, _LINEAR):
+    uint8_t           seq_last[4];  ///< the last sample taken, and the tick it went to
+    uint64_t          seq_tick[4];  ///< (re-anchoring after a clock step goes by them)
     odo_tick_input_t  in;         ///< the open tick's input being assembled
     odo_tick_output_t out;
     replay_stats_t    stats;
