@@ -144,6 +144,20 @@ static bool in_range(const odo_pose_t *p)
 
 bool odo_pose_in_range(const odo_pose_t *p) { return in_range(p); }
 
+/// sin(x) / x in Q30 for x = dtheta / 2, dtheta = dturn_q64 signed turns (below half a turn):
+/// 1 - x^2/6 + x^4/120 - x^6/5040 in Horner form, within 3e-5 up to |x| = pi/2. Multiplies only
+/// (Q30 reciprocals of 42, 20 and 6), every product below 2^62.
+static int32_t sinc_half_q30(int64_t dturn_q64)
+{
+    /* x in rad Q30 = pi * dturn / 2^64 * 2^30 = dturn * (pi * 2^29) / 2^63; |x| < pi/2 */
+    const int64_t x = odo_mul_s64_s32_shr(dturn_q64, 1686629713, 63U);
+    const int64_t x2 = (x * x) >> 30; /* x^2 in Q30, < 2.65e9 */
+    int64_t p = ODO_Q30_ONE - ((x2 * 25565282) >> 30);             /* 1 - x^2/42 */
+    p = ODO_Q30_ONE - ((((x2 * p) >> 30) * 53687091) >> 30);       /* 1 - x^2/20 (...) */
+    p = ODO_Q30_ONE - ((((x2 * p) >> 30) * 178956971) >> 30);      /* 1 - x^2/6 (...) */
+    return (int32_t)p;
+}
+
 void odo_truck_step(odo_truck_t *t, const odo_model_t *m, uint32_t left_raw, uint32_t right_raw,
                     uint8_t bits, uint32_t ticks, odo_step_t *out)
 {
@@ -205,7 +219,14 @@ void odo_truck_step(odo_truck_t *t, const odo_model_t *m, uint32_t left_raw, uin
                              m->turn_q64[0] * (uint64_t)(int64_t)d[0];
     const int64_t dturn = as_signed(dturn_u);
 
-    odo_pose_advance(&t->pose, dist, dturn, m->heading_form);
+    /* Over several ticks the midpoint form's step (the arc length U along the chord's direction)
+     * overshoots by U (1 - sinc(dtheta/2)), an error that grows with the cube of the gap: take the
+     * chord of the constant-curvature arc instead (only on this rare path; per tick the paper's
+     * U stays, as the double reference has it). */
+    const int64_t step = (ticks > 1U && m->heading_form == (uint8_t)ODO_HEADING_MIDPOINT)
+                             ? odo_mul_s64_s32_shr(dist, sinc_half_q30(dturn), 30U)
+                             : dist;
+    odo_pose_advance(&t->pose, step, dturn, m->heading_form);
     out->range = !in_range(&t->pose); /* held from the next step on */
     out->dist_mm_q40 = dist;
     out->dturn_q64 = dturn;

@@ -253,6 +253,34 @@ static void the_plausibility_limit_scales_with_the_ticks_elapsed(void)
     TEST_ASSERT_EQUAL_INT32(2, odo_count_delta(7U, 9U, 200U));
 }
 
+/// A step over several ticks of a constant-curvature arc (000 Eqs. 2.2-2.6 with the midpoint
+/// heading) lands on the arc: its length is taken as the chord, U sinc(dtheta/2), not U, whose
+/// overshoot grows with the cube of the gap. 6 ticks of a 0.5 m radius at 1 m/s: 2.3 mm.
+static void a_multi_tick_step_follows_the_arc(void)
+{
+    const odo_truck_params_t tp = labmate();
+    const odo_model_t m = model_of(&tp, 24U, ODO_HEADING_MIDPOINT);
+    const double k = cm_mm(&tp), b = 340.0, r_mm = 500.0, v = 1000.0;
+    const int32_t dl = (int32_t)llround(v * (1.0 - b / (2.0 * r_mm)) * 0.04 / k);
+    const int32_t dr = (int32_t)llround(v * (1.0 + b / (2.0 * r_mm)) * 0.04 / k);
+    odo_truck_t t = truck_at_origin(&m, 0U, 0U, 24U);
+    odo_step_t st;
+    odo_truck_step(&t, &m, (uint32_t)(6 * dl), (uint32_t)(6 * dr), 24U, 6U, &st);
+    TEST_ASSERT_FALSE(st.jump);
+    /* the exact arc through the same counts, in double precision */
+    const double u = 6.0 * k * (dl + dr) / 2.0, th = 6.0 * k * (dr - dl) / b;
+    const double chord = u * sin(th / 2.0) / (th / 2.0);
+    TEST_ASSERT_DOUBLE_WITHIN(0.005, chord * cos(th / 2.0), MM_Q32(t.pose.x_mm_q32));
+    TEST_ASSERT_DOUBLE_WITHIN(0.005, chord * sin(th / 2.0), MM_Q32(t.pose.y_mm_q32));
+    TEST_ASSERT_TRUE(u - chord > 2.0); /* what the step would have overshot */
+    TEST_ASSERT_DOUBLE_WITHIN(1e-9, th, TURNS_Q64_TO_RAD(t.pose.heading_q64));
+    /* per tick (ticks == 1) the step stays U along the midpoint, as the double reference has it */
+    odo_truck_t t1 = truck_at_origin(&m, 0U, 0U, 24U);
+    odo_truck_step(&t1, &m, (uint32_t)dl, (uint32_t)dr, 24U, 1U, &st);
+    const double u1 = k * (dl + dr) / 2.0, th1 = k * (dr - dl) / b;
+    TEST_ASSERT_DOUBLE_WITHIN(1e-6, u1 * cos(th1 / 2.0), MM_Q32(t1.pose.x_mm_q32));
+}
+
 /// A step over a long gap is bounded by what int64 mm Q40 can sum: a coarse encoder (100 counts
 /// per turn of a 477 mm wheel, 15 mm a count) with 32-bit counters can tell 100,000 ticks apart,
 /// but 200,000 counts would be 3,000 km, 2^62.5 per wheel in Q40: flagged, never overflowed.
@@ -316,6 +344,7 @@ int main(void)
     RUN_TEST(inverted_encoders_count_forward);
     RUN_TEST(parameters_that_cannot_be_represented_are_refused);
     RUN_TEST(the_plausibility_limit_scales_with_the_ticks_elapsed);
+    RUN_TEST(a_multi_tick_step_follows_the_arc);
     RUN_TEST(a_step_too_large_to_integrate_is_flagged);
     RUN_TEST(a_pose_beyond_the_limit_is_held);
     return UNITY_END();
