@@ -4,7 +4,8 @@
 ///
 /// Representations: position in mm Q32 (int64), heading in turns Q64 (uint64, wraps), per-wheel
 /// distance per count in mm Q40, per-wheel heading per count in turns Q64. One tick costs two
-/// 64x64 multiplies for the heading, two for distance and two 64x32 for position; no loops.
+/// 64x64 multiplies for the heading, two for distance and two 64x32 for position; no loops and no
+/// division (a step over a gap adds a few multiplies for the chord).
 ///
 /// Accuracy (tests/host/test_odometry_reference.c and odo-bench): against a double-precision
 /// reference fed the same counts, after 1 km of mixed driving the pose differs by <= 0.1 mm and
@@ -100,8 +101,12 @@ void odo_truck_reset(odo_truck_t *t, const odo_pose_t *pose);
 ///     for the counter width, or a w too narrow for one tick at the speed limit), or w == 0.
 /// out->range is set when the pose is beyond ODO_POSE_LIMIT_MM_Q32 after the step; a pose that was
 /// beyond it already is held (not integrated, baseline re-taken). A jump leaves out->range false.
-/// A heading change above half a turn in one step (a spin at speed over a long gap) is kept
-/// exactly modulo a turn, but its midpoint direction is then taken the short way round.
+/// Over several ticks (ticks > 1) with the midpoint heading form, the position moves by the chord
+/// of the constant-curvature arc, U sin(dtheta/2) / (dtheta/2), along the midpoint heading: the
+/// arc's end, where U alone would overshoot by a part growing with the cube of the gap. Per tick
+/// it moves by U, as 000 Eq. 2.5 and the double reference have it. A heading change above half a
+/// turn in one step (a spin at speed over a long gap) is kept exactly modulo a turn, but its
+/// midpoint direction is then taken the short way round.
 /// Never fails otherwise. Constant time: no loop over the gap.
 void odo_truck_step(odo_truck_t *t, const odo_model_t *m, uint32_t left_raw, uint32_t right_raw,
                     uint8_t bits, uint32_t ticks, odo_step_t *out);
