@@ -442,6 +442,15 @@ int main(int argc, char **argv)
     if (sink.csv == NULL || sink.log == NULL) {
         fprintf(stderr, "odo-replay: cannot create outputs in %s: %s\n", out != NULL ? tmp : "/dev/null",
                 strerror(errno));
+        if (sink.csv != NULL) {
+            fclose(sink.csv);
+        }
+        if (sink.log != NULL) {
+            fclose(sink.log);
+        }
+        if (out != NULL) {
+            remove_flat_dir(tmp); /* ours: nothing half-written stays behind */
+        }
         return 1;
     }
     static char csv_buf[1 << 16], log_buf[1 << 16];
