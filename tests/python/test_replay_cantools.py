@@ -267,3 +267,15 @@ def test_a_clock_step_back_is_re_anchored(tmp_path: Path) -> None:
     rows = list(csv.DictReader((out / "poses.csv").open()))
     backwards = [int(row["faults"], 16) & (1 << 17) != 0 for row in rows]
     assert backwards == [False] * 5 + [True] + [False] * 4
+
+
+def test_outputs_that_cannot_be_created_leave_no_temp_folder(tmp_path: Path) -> None:
+    """Out of file descriptors after DIR.tmp.PID was made (the second output cannot be opened):
+    a clear error, exit 1, and the temp folder removed with what it held."""
+    log = write(tmp_path / "in.log", GOOD)
+    r = subprocess.run(["bash", "-c", 'ulimit -n 5 && exec "$@"', "odo-replay",
+                        str(BIN / "odo-replay"), "--log", str(log), "--params",
+                        str(params_bin(tmp_path)), "--out", str(tmp_path / "o")],
+                       capture_output=True, text=True, timeout=60)
+    assert r.returncode == 1 and "cannot create outputs in" in r.stderr, r.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["in.log", "p.bin"]
