@@ -56,7 +56,6 @@ bool replay_deadline_us(const replay_t *r, uint64_t margin_us, uint64_t *deadlin
     return true;
 }
 
-/// `seq` is a newer sample than `held` (1..127 ahead, modulo 256).
 /// The four consumed frames by identifier (what odo_can_classify would say, without its table
 /// walk: this runs for every frame of a replay); ODO_CAN_MSG_UNKNOWN for anything else.
 static odo_can_msg_t sensor_msg(const odo_can_frame_t *f)
@@ -84,6 +83,7 @@ static bool sensor_seq(const odo_can_frame_t *f, odo_can_msg_t m, uint8_t *seq)
     return true;
 }
 
+/// `seq` is a newer sample than `held` (1..127 ahead, modulo 256).
 static bool newer(uint8_t held, uint8_t seq)
 {
     const uint8_t d = odo_can_seq_delta(held, seq);
