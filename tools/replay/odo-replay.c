@@ -227,7 +227,7 @@ static int write_summary(FILE *f, const char *mode, const char *input, const rep
         bad |= set_u64(b, "reopens", ss->reopens);
         bad |= json_object_set_new(o, "bus", b);
     }
-    bad |= json_dumpf(o, f, JSON_INDENT(2) | JSON_REAL_PRECISION(12)) != 0;
+    bad |= json_dumpf(o, f, JSON_REAL_PRECISION(12)) != 0; /* one line, as before */
     bad |= fputc('\n', f) == EOF;
     json_decref(o);
     return bad ? -1 : 0;
