@@ -76,18 +76,12 @@ static int64_t apply_sign_sat(uint64_t over, uint64_t mag, bool negative)
     return negative ? -(int64_t)mag : (int64_t)mag;
 }
 
-int64_t odo_mul_s64_s32_shr(int64_t a, int32_t b, unsigned shift)
+/// round(p / 2^shift) of a 96-bit magnitude p = (hi : lo), ties away from zero, with the sign
+/// applied and saturated to int64 (the shared tail of the two mul-shifts below).
+static int64_t shr96_round_sat(uint64_t hi, uint64_t lo, unsigned shift, bool negative)
 {
-    const bool negative = (a < 0) != (b < 0);
-    const uint64_t ua = mag_s64(a);
-    const uint64_t ub = (uint64_t)mag_s64((int64_t)b); /* < 2^32 */
-    /* 96-bit product |a| * |b| = (hi : lo), at most 2^63 * 2^31 = 2^94. */
-    const uint64_t p_lo = LO32(ua) * ub;
-    const uint64_t p_hi = (ua >> 32) * ub;
-    const uint64_t lo = p_lo + (p_hi << 32);
-    uint64_t hi = (p_hi >> 32) + (lo < p_lo ? 1U : 0U);
-    /* Round half away from zero on the magnitude: add half a unit of the result, then shift the
-     * 96-bit value. Whatever stays in `hi` after the shift is beyond 64 bits: saturate. */
+    /* Add half a unit of the result, then shift the 96-bit value. Whatever stays in `hi` after
+     * the shift is beyond 64 bits: saturate. */
     if (shift - 1U < 63U) { /* 1..63, every caller in the firmware */
         const uint64_t lo2 = lo + ((uint64_t)1U << (shift - 1U));
         hi += (lo2 < lo) ? 1U : 0U;
@@ -103,7 +97,89 @@ int64_t odo_mul_s64_s32_shr(int64_t a, int32_t b, unsigned shift)
         return apply_sign_sat(0U, (s == 0U) ? hi + (lo >> 63) : (hi + ((uint64_t)1U << (s - 1U))) >> s,
                               negative);
     }
-    return 0; /* |a * b| <= 2^94: below half a unit */
+    return 0; /* p < 2^95: below half a unit */
+}
+
+int64_t odo_mul_s64_s32_shr(int64_t a, int32_t b, unsigned shift)
+{
+    const uint64_t ua = mag_s64(a);
+    const uint64_t ub = (uint64_t)mag_s64((int64_t)b); /* < 2^32 */
+    /* 96-bit product |a| * |b| = (hi : lo), at most 2^63 * 2^31 = 2^94. */
+    const uint64_t p_lo = LO32(ua) * ub;
+    const uint64_t p_hi = (ua >> 32) * ub;
+    const uint64_t lo = p_lo + (p_hi << 32);
+    return shr96_round_sat((p_hi >> 32) + (lo < p_lo ? 1U : 0U), lo, shift, (a < 0) != (b < 0));
+}
+
+int64_t odo_mul_s64_u32_shr(int64_t a, uint32_t b, unsigned shift)
+{
+    const uint64_t ua = mag_s64(a);
+    const uint64_t ub = b;
+    /* 96-bit product |a| * b = (hi : lo), below 2^95. */
+    const uint64_t p_lo = LO32(ua) * ub;
+    const uint64_t p_hi = (ua >> 32) * ub;
+    const uint64_t lo = p_lo + (p_hi << 32);
+    return shr96_round_sat((p_hi >> 32) + (lo < p_lo ? 1U : 0U), lo, shift, a < 0 && b != 0U);
+}
+
+/// Leading zero bits of a non-zero value; portable C (five steps), so no compiler builtin.
+static unsigned clz32(uint32_t x)
+{
+    unsigned n = 0U;
+    if ((x & 0xFFFF0000UL) == 0U) {
+        n += 16U;
+        x <<= 16;
+    }
+    if ((x & 0xFF000000UL) == 0U) {
+        n += 8U;
+        x <<= 8;
+    }
+    if ((x & 0xF0000000UL) == 0U) {
+        n += 4U;
+        x <<= 4;
+    }
+    if ((x & 0xC0000000UL) == 0U) {
+        n += 2U;
+        x <<= 2;
+    }
+    return ((x & 0x80000000UL) == 0U) ? n + 1U : n;
+}
+
+/// One 16-bit quotient digit of (u * 2^16) / vn for u < vn, vn normalised (top bit set): the
+/// estimate u / vn1 is at most 2 too large and corrected with the next divisor digit vn0
+/// (Knuth, TAOCP vol. 2, 4.3.1, algorithm D, step D3). *rem gets the remainder, in [0, vn).
+static uint32_t div_digit(uint32_t u, uint32_t vn, uint32_t *rem)
+{
+    const uint32_t vn1 = vn >> 16, vn0 = vn & 0xFFFFU;
+    uint32_t q = u / vn1;
+    uint32_t rhat = u - q * vn1;
+    while (q > 0xFFFFU || q * vn0 > (rhat << 16)) {
+        q--;
+        rhat += vn1;
+        if (rhat > 0xFFFFU) {
+            break;
+        }
+    }
+    /* u * 2^16 - q * vn is the true remainder, in [0, vn): exact modulo 2^32. */
+    *rem = (u << 16) - q * vn;
+    return q;
+}
+
+uint32_t odo_frac_q32(uint32_t n, uint32_t d)
+{
+    if (n >= d) {
+        return UINT32_MAX; /* also d == 0 */
+    }
+    /* Scale both so d's top bit is set: the quotient is unchanged, n << s < d << s fits. */
+    const unsigned s = clz32(d);
+    const uint32_t vn = d << s;
+    uint32_t r1, r0;
+    const uint32_t q1 = div_digit(n << s, vn, &r1);
+    const uint32_t q0 = div_digit(r1, vn, &r0);
+    const uint32_t q = (q1 << 16) | q0;
+    /* Round half up on the remainder: r0 / vn >= 1/2. q + 1 cannot wrap: n < d gives
+     * n * 2^32 / d <= 2^32 - 2^32 / d < 2^32 - 1. */
+    return (r0 >= vn - r0) ? q + 1U : q;
 }
 
 int64_t odo_shr_round_s64(int64_t v, unsigned shift)

@@ -49,6 +49,18 @@ bool odo_muldiv_u64(uint64_t a, uint64_t b, uint64_t d, uint64_t *out);
 /// and a result beyond int64 saturates to INT64_MIN / INT64_MAX. Three 32x32 multiplies.
 int64_t odo_mul_s64_s32_shr(int64_t a, int32_t b, unsigned shift);
 
+/// round(a * b / 2^shift) for an unsigned 32-bit b, as odo_mul_s64_s32_shr: exact through a
+/// 96-bit product, ties away from zero, every shift valid (96 and above give 0), saturating
+/// beyond int64. Three 32x32 multiplies.
+int64_t odo_mul_s64_u32_shr(int64_t a, uint32_t b, unsigned shift);
+
+/// The fraction n / d in Q32: round(n * 2^32 / d) for n < d, which is at most 2^32 - 1, so it
+/// always fits; saturates to UINT32_MAX when n >= d (d == 0 included). Exact rounding (ties
+/// cannot occur: d < 2^32 has at most 31 factors of two). Two 32/32 divisions after
+/// normalising d (Knuth's algorithm D with 16-bit digits, as Hacker's Delight's divlu), so no
+/// 64-bit division: constant time apart from at most two corrections per digit.
+uint32_t odo_frac_q32(uint32_t n, uint32_t d);
+
 /// round(v / 2^shift), ties away from zero (an arithmetic right shift with rounding to nearest).
 /// Every input is valid: shift 0 returns v; shift 64 and above return 0, except -1 for INT64_MIN
 /// at exactly 64 (|v| / 2^64 = 1/2). Never overflows.
