@@ -38,7 +38,7 @@ typedef struct {
 /// One sample of a truck's two wheel-encoder counters, as the decoder (or the sensor frame) gives it.
 typedef struct {
     bool     present;      ///< a sample for this tick arrived; false: nothing arrived
-    uint8_t  bits;         ///< valid low bits in left/right_raw: 16, 24 or 32 (a CAN frame: 24);
+    uint8_t  bits;         ///< valid low bits in left/right_raw, 8 to 32 (a CAN frame: 24);
                            ///< above 32 counts as 32, 0 makes the sample unusable (flagged)
     uint8_t  seq;          ///< sender's sample sequence number, +1 per tick (wraps at 256): a skip
                            ///< says how many ticks the counters moved over
