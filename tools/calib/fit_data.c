@@ -36,6 +36,8 @@ typedef struct {
     size_t      cap;
     odo_truck_t shadow;
     int         oom;
+    int         have_seq;
+    uint8_t     last_seq;
 } collect_t;
 
 static void on_tick(void *user, replay_t *r, uint64_t tick, const odo_tick_input_t *in, const odo_tick_output_t *out)
@@ -59,10 +61,15 @@ static void on_tick(void *user, replay_t *r, uint64_t tick, const odo_tick_input
         }
         c->cap = cap;
     }
-    odo_step_t st = {0};
+    odo_step_t st;
+    memset(&st, 0, sizeof st);
     if (in->wheel[0].present) {
+        /* ticks since the previous sample, from the sender's sequence number as the app takes it */
+        const uint32_t skip = c->have_seq ? (uint32_t)(uint8_t)(in->wheel[0].seq - c->last_seq) : 1U;
+        c->have_seq = 1;
+        c->last_seq = in->wheel[0].seq;
         odo_truck_step(&c->shadow, &r->app.model[0], in->wheel[0].left_raw, in->wheel[0].right_raw, in->wheel[0].bits,
-                       &st);
+                       skip == 0U ? 1U : skip, &st);
     }
     run->t_s[run->n] = (double)tick * (double)r->tick_us * 1e-6;
     run->delta[run->n][0] = st.delta[0];
