@@ -5,6 +5,7 @@ JSON-serialisable dict); simulate.py turns a key and a seed into recorded data.
 
 from __future__ import annotations
 
+import json
 import math
 
 import numpy as np
@@ -33,6 +34,13 @@ OUT_OF_CATALOG: list[str] = [
     "castor_swivel",
     "clock_drift",
 ]
+OOC_LAW = {
+    "diameter_drift": "thermal",
+    "gear_backlash": "play",
+    "encoder_eccentricity": "once_per_turn",
+    "castor_swivel": "trailing",
+    "clock_drift": "linear",
+}
 TWO_TRUCK_ONLY = {"rotary_bias": ("clapper", "set"), "link_bias": ("clapper",)}
 DRIVE_EFFECTS = {"slip", "skid", "scrub"}  # act where a motor drives a wheel
 FLOOR_EFFECTS = {"bumps", "roughness"}  # act on every wheel that rolls over the floor
@@ -67,38 +75,41 @@ def ooc_choices(vehicle: str) -> list[str]:
 # ------------------------------------------------------------------------------------------------
 
 
-def _encoder(rng, need: str) -> tuple[float, float]:
+def _encoder(rng, need: str) -> tuple[int, float]:
     """(encoder_lines, gear_ratio) for a wanted kind of drive train."""
     if need == "wheel":  # encoder on the wheel shaft
-        return float(rng.choice([256, 360, 512, 1000, 1024, 2048, 4096])), 1.0
+        return int(rng.choice([256, 360, 512, 1000, 1024, 2048, 4096])), 1.0
     if need == "high":
         cpr = _logu(rng, 30000, 200000)
     elif need == "geared":
         cpr = _logu(rng, 2000, 100000)
     else:
-        cpr = _logu(rng, 64, 200000)
+        cpr = _logu(rng, 100, 200000)  # the firmware's parameter block wants >= 100
     gears = [1.0, 3.7, 5.0, 10.0, 14.0, 19.5, 30.0, 43.7, 50.0]
     if need == "geared":
         gears = gears[2:]
     g = float(rng.choice([x for x in gears if cpr / (4 * x) >= 4] or [1.0]))
-    lines = max(4, round(cpr / (4 * g)))
-    return float(lines), g
+    return max(4, math.ceil(max(cpr, 100.0) / (4 * g))), g
 
 
-def _truck(rng, D: float, b: float, lines: float, gear: float, vmax: float, T: float) -> dict:
-    cpr = 4 * lines * gear
-    per_tick = vmax * 1.5 * T / (math.pi * D) * cpr
-    bits = [x for x in COUNTER_BITS if per_tick < (1 << (x - 1)) / 4]
+def _truck(rng, D: float, b: float, lines: int, gear: float, bits: int) -> dict:
     return {
         "wheel_diameter_mm": round(D, 2),
         "wheelbase_mm": round(b, 1),
         "encoder_lines": lines,
         "gear_ratio": gear,
-        "counter_bits": int(rng.choice(bits)),
+        "counter_bits": bits,
         "decoder": "hctl1100",
         "invert_left": bool(rng.uniform() < 0.3),
         "invert_right": False,
     }
+
+
+def _bits(rng, vmax: float, T: float, trucks: list[tuple[float, int, float]]) -> int:
+    """One counter width for the robot (the firmware has one), wide enough that a cycle's count
+    stays far below half its range on every truck."""
+    per_tick = max(vmax * 1.5 * T / (math.pi * D) * 4 * ln * g for D, ln, g in trucks)
+    return int(rng.choice([x for x in COUNTER_BITS if per_tick < (1 << (x - 1)) / 4]))
 
 
 def draw_robot(rng: np.random.Generator, vehicle: str, need: str) -> dict:
@@ -108,6 +119,14 @@ def draw_robot(rng: np.random.Generator, vehicle: str, need: str) -> dict:
     tick = int(rng.choice(TICKS_MS))
     vmax = float(np.clip(rng.uniform(4.0, 12.0) * D, 500, 3000))  # wheel surface speed, mm/s
     lines, gear = _encoder(rng, need)
+    T = tick / 1000
+    drives = [(D, lines, gear)]
+    if vehicle == "set":
+        Db = _logu(rng, 50, 150)
+        bb = float(np.clip(b * rng.uniform(0.6, 1.2), 150, 800))
+        lb, gb = _encoder(rng, "wheel" if need != "high" else "high")
+        drives.append((Db, lb, gb))
+    bits = _bits(rng, vmax, T, drives)
     rob = {
         "vehicle": vehicle,
         "description": "A robot of the independent world (odo_tools.validation.indep).",
@@ -115,7 +134,7 @@ def draw_robot(rng: np.random.Generator, vehicle: str, need: str) -> dict:
         "heading_form": "midpoint",
         "ipec": "off",
         "max_wheel_speed_mm_s": round(vmax),
-        "trucks": {"A": _truck(rng, D, b, lines, gear, vmax, tick / 1000)},
+        "trucks": {"A": _truck(rng, D, b, lines, gear, bits)},
     }
     if vehicle == "clapper":
         rob["trucks"]["B"] = dict(rob["trucks"]["A"])
@@ -129,10 +148,7 @@ def draw_robot(rng: np.random.Generator, vehicle: str, need: str) -> dict:
             "linear_resolution_mm": float(rng.choice([0.01, 0.02, 0.05, 0.1])),
         }
     elif vehicle == "set":
-        Db = _logu(rng, 50, 150)
-        bb = float(np.clip(b * rng.uniform(0.6, 1.2), 150, 800))
-        lb, gb = _encoder(rng, "wheel" if need != "high" else "high")
-        rob["trucks"]["B"] = _truck(rng, Db, bb, lb, gb, vmax, tick / 1000)
+        rob["trucks"]["B"] = _truck(rng, Db, bb, lb, gb, bits)
         rob["trailer"] = {
             "hitch_offset_mm": float(round(rng.uniform(0.3, 0.9) * b)),
             "trailer_length_mm": float(round(rng.uniform(1.2, 3.0) * bb)),
@@ -148,25 +164,29 @@ def draw_robot(rng: np.random.Generator, vehicle: str, need: str) -> dict:
 
 def draw_controller(rng, rob: dict, effects: list[str]) -> dict:
     A = rob["trucks"]["A"]
+    b = A["wheelbase_mm"]
     vw = rob["max_wheel_speed_mm_s"]
     v = min(rng.uniform(250, 800), 0.6 * vw)
     acc = rng.uniform(400, 1200)
     alat = rng.uniform(400, 1200)
     if "slip" in effects:
         acc = rng.uniform(900, 1600)
-    if "skid" in effects:
+    dec = acc * rng.uniform(1.0, 1.6)
+    if "skid" in effects:  # brisk turns, gentle starts and stops
         alat = rng.uniform(1300, 2500)
-        v = min(max(v, 600.0), 0.7 * vw)
+        v = min(max(v, 700.0), 0.7 * vw)
+        acc = rng.uniform(300, 500)
+        dec = acc * rng.uniform(1.0, 1.3)
+    w_spin = min(rng.uniform(0.6, 2.0), 0.6 * vw / (b / 2))
     if "count_loss" in effects:
         v = min(max(v, 500.0), 0.7 * vw)
-    b = A["wheelbase_mm"]
     return {
         "v_mm_s": _f(v),
         "a_mm_s2": _f(acc),
-        "d_mm_s2": _f(acc * rng.uniform(1.0, 1.6)),
+        "d_mm_s2": _f(dec),
         "jerk_s": _f(rng.uniform(0.05, 0.3)),
         "a_lat_mm_s2": _f(alat),
-        "w_rad_s": _f(min(rng.uniform(0.6, 2.0), 0.6 * vw / (b / 2))),
+        "w_rad_s": _f(w_spin),
         "alpha_rad_s2": _f(rng.uniform(1.5, 5.0)),
         "pause_s": _f(rng.uniform(0.3, 1.0)),
         "cmd_accel_mm_s2": _f(2.5 * max(acc, alat)),
@@ -174,11 +194,12 @@ def draw_controller(rng, rob: dict, effects: list[str]) -> dict:
     }
 
 
-def limits(case: dict) -> paths.Limits:
+def limits(case: dict, run: dict | None = None) -> paths.Limits:
+    """The planner's bounds; a run may ask for its own cruise speed (a sprint)."""
     c = case["controller"]
     A = case["robot"]["trucks"]["A"]
     return paths.Limits(
-        v=c["v_mm_s"],
+        v=(run or {}).get("v_mm_s", c["v_mm_s"]),
         a=c["a_mm_s2"],
         d=c["d_mm_s2"],
         jerk_s=c["jerk_s"],
@@ -195,8 +216,36 @@ def _r(x: float) -> float:
     return float(round(x, -1))
 
 
-def draw_plan(rng: np.random.Generator, rob: dict, effects: list[str]) -> list[dict]:
-    """6-12 runs of several shapes; UMBmark squares in both directions always among them."""
+def _duration(segs: list, lim: paths.Limits) -> float:
+    return paths.duration([tuple(s) for s in segs], lim)
+
+
+def _fit(segs: list, lim: paths.Limits, max_s: float, rmin: float) -> list:
+    """Shrink a run (lengths and radii, radii not below rmin; then arc and spin angles) until
+    it lasts at most max_s."""
+    for _ in range(6):
+        d = _duration(segs, lim)
+        if d <= max_s:
+            break
+        f = max(0.5, 0.97 * max_s / d)
+        out = []
+        for sg in segs:
+            if sg[0] == "line":
+                out.append(("line", sg[1] * f))
+            elif sg[0] == "arc":
+                r = max(sg[1] * f, rmin)
+                ang = sg[2] if r > rmin + 1e-9 else sg[2] * f
+                out.append(("arc", r, ang))
+            else:
+                out.append(sg if abs(sg[1]) <= math.pi / 2 + 1e-9 else ("spin", sg[1] * f))
+        segs = out
+    return segs
+
+
+def draw_plan(rng: np.random.Generator, case: dict, effects: list[str]) -> list[dict]:
+    """6-12 runs of several shapes; UMBmark squares in both directions always among them. A
+    run lasts at most max(30 s, 2500 control cycles) and 50 s."""
+    rob = case["robot"]
     veh = rob["vehicle"]
     b = rob["trucks"]["A"]["wheelbase_mm"]
     side = float(np.clip(round(rng.uniform(6, 14) * b, -2), 1000, 5000))
@@ -252,6 +301,22 @@ def draw_plan(rng: np.random.Generator, rob: dict, effects: list[str]) -> list[d
         else:
             segs = paths.drive(rng, int(rng.integers(5, 10)), rmin, max(3 * rmin, 2000.0), side)
             plan.append({"label": "drive", "shape": sh, "segs": segs})
+    if "skid" in effects:  # tight circles at speed: the turns that ask most of the floor
+        for i in range(2):
+            R = _r(rng.uniform(1.0, 1.6) * rmin)
+            ccw = bool(rng.uniform() < 0.5)
+            plan[-1 - i] = {"label": "circleccw" if ccw else "circlecw", "shape": "circle",
+                            "segs": paths.circle(R, ccw, 2.0)}
+    if "count_loss" in effects:  # a straight sprint: the one place the wheels run fastest
+        L = _r(rng.uniform(0.8, 1.2) * side)
+        sprint = {"label": "sprint", "shape": "sprint", "v_mm_s": _f(min(
+            case["controller"]["v_mm_s"] * rng.uniform(1.4, 1.7),
+            0.85 * rob["max_wheel_speed_mm_s"]))}
+        sprint["segs"] = paths.shuttle(L) if veh == "labmate" else [("line", L)]
+        plan[-1] = sprint
+    max_s = min(50.0, max(30.0, 2500 * rob["tick_ms"] / 1000))
+    for p in plan:
+        p["segs"] = _fit(p["segs"], limits(case, p), max_s, rmin)
     order = rng.permutation(len(plan))
     plan = [plan[i] for i in order]
     counts: dict[str, int] = {}
@@ -310,7 +375,8 @@ def _cables(rng, case: dict, law: str) -> list[dict]:
             kind, h = "step", rng.uniform(3, 15)
             width, slope = rng.choice([0.0, rng.uniform(5, 40)]), 0.0
         elif rng.uniform() < 0.5:
-            kind, h, width, slope = "ramp", rng.uniform(8, 25), rng.uniform(20, 80), rng.uniform(10, 30)
+            kind, h = "ramp", rng.uniform(8, 25)
+            width, slope = rng.uniform(20, 80), rng.uniform(10, 30)
         else:
             kind, h, width, slope = "round", rng.uniform(4, 15), 0.0, 0.0
         out.append({"x": _f(x), "y": _f(y), "angle_deg": _f(math.degrees(ang)),
@@ -323,7 +389,7 @@ def draw_effect(rng, name: str, case: dict) -> tuple[dict, dict]:
     """One effect: (true law parameters, catalog-equivalent params)."""
     rob = case["robot"]
     veh = rob["vehicle"]
-    law = str(rng.choice(EFFECTS[name])) if name in EFFECTS else "law"
+    law = str(rng.choice(EFFECTS[name])) if name in EFFECTS else OOC_LAW[name]
     e: dict = {"law": law, "truck": _scope(rng, name, veh)}
     tname = "B" if e["truck"] == "B" else "A"
     tr = rob["trucks"][tname]
@@ -366,26 +432,36 @@ def draw_effect(rng, name: str, case: dict) -> tuple[dict, dict]:
             e.update(sigma_mm=_f(rng.uniform(0.15, 0.6)), corr_mm=_f(rng.uniform(4, 15)))
     elif name == "slip":
         if law == "accel":
-            e.update(k_at_1=_f(rng.uniform(0.01, 0.05)), p=_f(rng.uniform(1.5, 3.0)), cap=0.3,
+            e.update(k_at_1=_f(rng.uniform(0.02, 0.08)), p=_f(rng.uniform(1.2, 2.5)), cap=0.3,
                      asym=_f(rng.uniform(-0.3, 0.3)))
         else:
-            e["a_lim_m_s2"] = _f(rng.uniform(0.4, 0.8) * ctl["a_mm_s2"] / 1000)
+            e["a_lim_m_s2"] = _f(rng.uniform(0.7, 0.95) * ctl["a_mm_s2"] / 1000)
     elif name == "skid":
-        if law == "friction":
-            e["a_lim_m_s2"] = _f(rng.uniform(0.5, 0.85) * ctl["a_lat_mm_s2"] / 1000)
+        alat = _peak_plan(case)[1]  # the hardest turn of the plan, mm/s^2
+        if law == "friction":  # the hardest turns ask for more than the floor gives; starts do not
+            a_long = max(ctl["a_mm_s2"], ctl["d_mm_s2"]) * 1.25
+            e["a_lim_m_s2"] = _f(max(a_long, rng.uniform(0.6, 0.85) * alat) / 1000)
         else:
-            e["c_alpha_m_s2"] = _f(ctl["a_lat_mm_s2"] / 1000 / math.radians(rng.uniform(1, 4)))
+            e["c_alpha_m_s2"] = _f(alat / 1000 / math.radians(rng.uniform(1, 5)))
     elif name == "count_loss":
+        # the fastest any wheel of the truck runs in the plan (edges/s): one wheel losing a
+        # per cent of its counts in a turn costs degrees, so the losses are kept to the peaks
         cpr = 4 * tr["encoder_lines"] * tr["gear_ratio"]
-        peak = ctl["v_mm_s"] / (2 * math.pi * r) * cpr
+        peak = _peak_plan(case)[0] / (2 * math.pi * r) * cpr
         if law == "rate_limit":
-            fs = float(np.clip(rng.uniform(0.55, 0.9) * peak, 1e5 / 3, 2e6 / 3))
-            e["f_sample_hz"] = fs
+            fs = float(np.clip(rng.uniform(1.02, 1.1) * peak, 1e5 / 3, 2e6 / 3))
+            e["f_max_hz"] = fs
             p["count_loss.f_clk_hz"] = 3 * fs
+            top = fs * rng.uniform(1.05, 1.3)
         else:
-            e.update(r50_hz=_f(rng.uniform(0.5, 0.9) * peak),
-                     width_hz=_f(rng.uniform(0.05, 0.15) * peak),
-                     p_max=_f(rng.uniform(0.005, 0.03)))
+            e.update(r50_hz=_f(rng.uniform(0.9, 1.2) * peak),
+                     width_hz=_f(rng.uniform(0.03, 0.1) * peak),
+                     p_max=_f(rng.uniform(0.0005, 0.003)))
+            top = e["r50_hz"] + e["width_hz"] * rng.uniform(0.0, 2.0)
+        for run in case["plan"]:  # the sprint runs just above the decoder's limit
+            if run["shape"] == "sprint":
+                v = top / cpr * 2 * math.pi * r
+                run["v_mm_s"] = _f(min(v, 0.9 * rob["max_wheel_speed_mm_s"]))
     elif name == "scrub":
         if law == "inv_radius":
             e["c_mm"] = _f((1 if rng.uniform() < 0.8 else -1) * b * rng.uniform(0.0025, 0.015))
@@ -394,16 +470,16 @@ def draw_effect(rng, name: str, case: dict) -> tuple[dict, dict]:
             e.update(s_sat=_f(rng.uniform(0.005, 0.025)), r_t_mm=_f(rng.uniform(1.5, 4) * b / 2))
     elif name == "tire_compression":
         load = _f(mech["mass_kg"] * rng.uniform(0.5, 1.5))
-        off = _f(rng.uniform(-0.25, 0.25) * b)
+        off = _f(rng.uniform(-0.15, 0.15) * b)
+        delta = r * rng.uniform(0.002, 0.008)  # mean deflection: Es 0.2-0.8 %
         if law == "linear":
-            k = max(rng.uniform(0.003, 0.02), 0.004 * r / load)
-            e.update(k_mm_per_kg=_f(k), load_kg=load, lateral_offset_mm=off)
+            e.update(k_mm_per_kg=_f(delta / (load / 2)), load_kg=load, lateral_offset_mm=off)
             p.update({"tire_compression.k_mm_per_kg": e["k_mm_per_kg"],
                       "tire_compression.load_kg": load,
                       "tire_compression.lateral_offset_mm": off})
         else:
             n23 = (load * 9.81 / 2) ** (2 / 3)
-            e.update(c_mm_per_N23=_f(r * rng.uniform(0.004, 0.02) / n23), load_kg=load,
+            e.update(c_mm_per_N23=_f(delta / n23), load_kg=load,
                      lateral_offset_mm=off, cg_height_mm=_f(mech["cg_height_mm"]))
     elif name == "rotary_bias":
         two = veh == "clapper"
@@ -433,7 +509,7 @@ def draw_effect(rng, name: str, case: dict) -> tuple[dict, dict]:
         e["beta_left"], e["beta_right"] = (big, small) if rng.uniform() < 0.5 else (small, big)
         e["tau_s"] = _f(rng.uniform(100, 600))
     elif name == "gear_backlash":
-        e["play_deg"] = _f(rng.uniform(1.0, 4.0))
+        e["play_deg"] = _f(rng.uniform(1.5, 5.0))
     elif name == "encoder_eccentricity":
         e.update(amp_deg_left=_f(rng.uniform(1, 3)), amp_deg_right=_f(rng.uniform(1, 3)),
                  phase_left=_f(rng.uniform(0, 2 * math.pi)),
@@ -449,6 +525,22 @@ def draw_effect(rng, name: str, case: dict) -> tuple[dict, dict]:
         if isinstance(v, (np.floating, np.integer)):
             e[k] = float(v)
     return e, {k: float(v) for k, v in p.items()}
+
+
+def _peak_plan(case: dict) -> tuple[float, float]:
+    """Largest wheel surface speed (mm/s) and lateral acceleration (mm/s^2) truck A's plan asks
+    for, sprints aside."""
+    if "_peak" not in case:
+        v_w = a_lat = 0.0
+        for p in case["plan"]:
+            if p["shape"] == "sprint":
+                continue
+            lim = limits(case, p)
+            ref = paths.build([tuple(s) for s in p["segs"]], lim)
+            v_w = max(v_w, float(np.max(np.abs(ref.v) + np.abs(ref.w) * lim.b / 2)))
+            a_lat = max(a_lat, float(np.max(np.abs(ref.v * ref.w))))
+        case["_peak"] = (v_w, a_lat)
+    return case["_peak"]
 
 
 def visible(name: str, scope: str, vehicle: str) -> dict[str, bool]:
@@ -561,12 +653,31 @@ def draw_case(rng: np.random.Generator, k: int) -> dict:
             "effects": {},
         },
     }
-    case["plan"] = draw_plan(rng, rob, names)
+    case["plan"] = draw_plan(rng, case, names)
     for n in names:
         e, p = draw_effect(rng, n, case)
+        case.pop("_peak", None)
         case["true"]["effects"][n] = e
         case["laws"][n] = e["law"]
         case["params"].update(p)
         case["scope"][n] = e["truck"]
         case["visible"][n] = visible(n, e["truck"], vehicle)
     return case
+
+
+def quiet(case: dict) -> dict:
+    """The same case on a perfect floor with perfect sensors (no background roughness, no truth
+    or return noise, no lever arm, latency or jitter, exact placement, no CAN delays, equal
+    encoder states): for tests that check a law against its equation. draw_case never makes
+    one; every drawn case has a background."""
+    c = json.loads(json.dumps(case))
+    c["true"]["background"] = {"law": "grains", "rate_per_m": 0.0, "height_mm": 0.0,
+                               "shape_w": 4.0}
+    c["true"]["encoder"]["state_error"] = 0.0
+    f = c["fidelity"]
+    for k in ("truth_latency_s", "truth_jitter_s", "truth_noise_mm", "truth_noise_deg",
+              "truth_heading_offset_deg", "return_noise_mm", "return_noise_deg", "placement_mm",
+              "placement_deg", "can_proc_delay_s", "can_rx_jitter_s", "can_drop_rate"):
+        f[k] = 0.0
+    f["truth_lever_arm_mm"] = {t: [0.0, 0.0] for t in f["truth_lever_arm_mm"]}
+    return c

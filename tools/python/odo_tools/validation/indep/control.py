@@ -16,6 +16,9 @@ import numpy as np
 
 from .laws import wrap
 
+EX_MAX = 40.0  # mm, the along-track error the controller acts on at most
+EH_MAX = 0.05  # rad, the heading error it acts on at most
+
 
 class Odometry:
     """Dead reckoning of one truck per run from raw wrapping counters (midpoint heading,
@@ -103,8 +106,10 @@ class Controller:
                 v = vr * np.cos(eth) + self.klink * (link[:, 2] - self.link_len)
                 w = wr - self.kh * wrap(link[:, 1] - ref["bd"][k])
             else:
-                v = vr * np.cos(eth) + self.kx * (c * dx + s * dy)
-                w = wr + self.ky * vr * (c * dy - s * dx) + self.kh * np.sin(eth)
+                # bounded catch-up: a robot that lags its reference (its own view) drives at
+                # most kx * EX_MAX faster than planned
+                v = vr * np.cos(eth) + self.kx * np.clip(c * dx + s * dy, -EX_MAX, EX_MAX)
+                w = wr + self.ky * vr * (c * dy - s * dx) + self.kh * np.clip(eth, -EH_MAX, EH_MAX)
             hb = od.b / 2
             vw = np.empty((self.R, 2))
             vw[:, 0] = v - w * hb

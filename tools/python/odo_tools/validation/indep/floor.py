@@ -19,6 +19,7 @@ from functools import lru_cache
 
 import numpy as np
 
+
 def envelope(px: np.ndarray, pz: np.ndarray, R: float, x: np.ndarray) -> np.ndarray:
     """Height of the wheel centre above its resting height, over the floor (z = 0) plus an
     obstacle given by points (px, pz) of its top surface (dense enough that the wheel cannot
@@ -188,7 +189,7 @@ def surface(
     # the wheel bridges dips narrower than its contact chord: envelope by shifted maxima
     w = math.sqrt(2 * R * 4 * sigma_mm)
     yc = z.copy()
-    for j in range(1, min(int(math.ceil(w / dx)), m - 1) + 1):
+    for j in range(1, min(math.ceil(w / dx), m - 1) + 1):
         c = math.sqrt(max(R * R - (j * dx) ** 2, 0.0)) - R
         yc[j:] = np.maximum(yc[j:], z[:-j] + c)
         yc[:-j] = np.maximum(yc[:-j], z[j:] + c)

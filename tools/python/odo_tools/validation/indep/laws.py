@@ -70,22 +70,24 @@ def traction(vw, vg0, alim, dt):
     return out
 
 
-def skid_friction(ax_lat, vy0, alim, dt):
-    """Lateral skid by a friction limit. ax_lat (..., n) is the centripetal acceleration the
-    truck needs (v omega, mm/s^2); the floor supplies at most alim. The body-frame lateral
-    speed obeys dvy/dt = F/m - v omega with |F/m| <= alim: it stays 0 while the floor can hold
-    the turn, slides outward when it cannot, and is braked by friction until it sticks again.
-    Returns vy (..., n). Sequential over the substeps."""
-    out = np.empty_like(ax_lat)
-    vy = vy0
-    for k in range(ax_lat.shape[-1]):
-        a = ax_lat[..., k]
-        holds = np.abs(a) <= alim
-        dirn = np.where(vy != 0.0, -np.sign(vy), np.sign(a))  # friction on the body
-        vnew = vy + (dirn * alim - a) * dt
-        back = (vy != 0.0) & (np.sign(vnew) != np.sign(vy)) & holds
-        vy = np.where(((vy == 0.0) & holds) | back, 0.0, vnew)
-        out[..., k] = vy
+def friction_circle(tx, ty, v0, alim, dt):
+    """Skid by the friction circle: the wheels want the truck's centre to move at (tx, ty)
+    (..., n) (their rolling speed along the heading, world frame); the floor can change the
+    centre's velocity by at most alim (mm/s^2) in any direction, longitudinal and lateral
+    together. While the wanted change is within that the centre follows (stick); beyond it the
+    truck slides outward in a turn and its centre lags. v0 (..., 2) the velocity before.
+    Returns the velocity (..., 2, n). Sequential over the substeps (a 2-D rate limiter)."""
+    out = np.empty((*tx.shape[:-1], 2, tx.shape[-1]))
+    v = v0.copy()
+    step = alim * dt
+    for k in range(tx.shape[-1]):
+        dx = tx[..., k] - v[..., 0]
+        dy = ty[..., k] - v[..., 1]
+        m = np.hypot(dx, dy)
+        f = np.minimum(1.0, step / np.maximum(m, 1e-12))
+        v[..., 0] += f * dx
+        v[..., 1] += f * dy
+        out[..., :, k] = v
     return out
 
 
@@ -110,17 +112,13 @@ def scrub_torque(dth, dl, dr, b, s_sat, r_t):
     return dth - np.sign(dth) * np.minimum(loss, np.abs(dth))
 
 
-def decode_sampling(dedges, nsamp):
-    """A decoder that samples the quadrature state nsamp times per substep: each sample sees
-    the state advance d; d = 1 counts, d = 2 is an illegal transition (skipped, not counted), d = 3
-    is read as one step back (aliasing). Below one edge per sample it counts every edge.
-    dedges (..., n) int; nsamp (n,) int > 0. Returns (counted (..., n), skipped (..., n) bool)."""
-    q = np.floor_divide(dedges, nsamp)
-    r = dedges - q * nsamp
-    w = np.array([0, 1, 0, -1])
-    counted = r * w[(q + 1) % 4] + (nsamp - r) * w[q % 4]
-    skipped = ((r > 0) & ((q + 1) % 4 == 2)) | ((nsamp - r > 0) & (q % 4 == 2))
-    return counted, skipped
+def decode_saturating(dedges, slots):
+    """An interrupt-driven decoder that can handle at most one edge per interrupt slot (slots
+    (n,) per substep, f_max per second): edges that come faster coalesce into one interrupt and
+    are lost. dedges (..., n) int. Returns (counted (..., n), overrun (..., n) bool)."""
+    a = np.abs(dedges)
+    got = np.minimum(a, slots)
+    return np.sign(dedges) * got, got < a
 
 
 def missed_prob(rate_hz, r50, width, pmax):

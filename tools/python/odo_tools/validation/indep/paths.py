@@ -94,12 +94,11 @@ def geometry(segs: list[tuple], x0: float, y0: float, th0: float) -> np.ndarray:
     return g
 
 
-def profile(length: float, vlim: np.ndarray, a: float, d: float, jerk_s: float) -> np.ndarray:
-    """Distance covered on the 1 ms grid along a path of `length` whose speed bound on the
-    uniform grid `vlim` (first and last point included) is given; starts and ends at rest."""
+def _passes(length: float, vlim: np.ndarray, a: float, d: float) -> np.ndarray:
+    """Speeds on the grid under the bounds: v^2 grows by at most 2 a ds per grid step,
+    w_i = min_j (vlim_j^2 + 2 a ds (i - j)), w_0 = 0; the same backwards with d."""
     n = vlim.size
     ds = length / (n - 1)
-    # v^2 grows by at most 2 a ds per grid step: w_i = min_j (vlim_j^2 + 2 a ds (i - j)), w_0 = 0
     i = np.arange(n)
     w = vlim**2
     w[0] = 0.0
@@ -107,7 +106,15 @@ def profile(length: float, vlim: np.ndarray, a: float, d: float, jerk_s: float) 
     w[-1] = 0.0
     j = (n - 1) - i
     w = (np.minimum.accumulate((w - 2.0 * d * ds * j)[::-1]) + 2.0 * d * ds * j[::-1])[::-1]
-    v = np.sqrt(np.maximum(w, 0.0))
+    return np.sqrt(np.maximum(w, 0.0))
+
+
+def profile(length: float, vlim: np.ndarray, a: float, d: float, jerk_s: float) -> np.ndarray:
+    """Distance covered on the 1 ms grid along a path of `length` whose speed bound on the
+    uniform grid `vlim` (first and last point included) is given; starts and ends at rest."""
+    n = vlim.size
+    ds = length / (n - 1)
+    v = _passes(length, vlim, a, d)
     dt = 2.0 * ds / np.maximum(v[1:] + v[:-1], 1e-9)
     t = np.concatenate([[0.0], np.cumsum(dt)])
     m = max(2, math.ceil(t[-1] / DT_REF) + 1)
@@ -167,12 +174,7 @@ def build(segs: list[tuple], lim: Limits, lead_in_mm: float = 0.0, lead_s: float
             x, y = float(px[-1]), float(py[-1])
         else:
             g = geometry(mv, x, y, th)
-            L = float(g[-1, 0])
-            npt = max(3, math.ceil(L / DS) + 1)
-            su = np.linspace(0.0, L, npt)
-            k = np.abs(np.interp(su, g[:, 0], g[:, 4]))
-            vl = np.minimum(lim.v, np.sqrt(lim.a_lat / np.maximum(k, 1e-12)))
-            vl = np.minimum(vl, lim.v_wheel / (1.0 + k * lim.b / 2.0))
+            L, vl = _vlim_fwd(g, lim)
             prof = profile(L, vl, lim.a, lim.d, lim.jerk_s)
             px = np.interp(prof, g[:, 0], g[:, 1])
             py = np.interp(prof, g[:, 0], g[:, 2])
@@ -189,6 +191,38 @@ def build(segs: list[tuple], lim: Limits, lead_in_mm: float = 0.0, lead_s: float
     n = cols[0].size
     geo = np.vstack(geos) if geos else None
     return Ref(np.arange(n) * DT_REF, *cols, geo=geo)
+
+
+def _vlim_fwd(g: np.ndarray, lim: Limits) -> tuple[float, np.ndarray]:
+    L = float(g[-1, 0])
+    npt = max(3, math.ceil(L / DS) + 1)
+    su = np.linspace(0.0, L, npt)
+    k = np.abs(np.interp(su, g[:, 0], g[:, 4]))
+    vl = np.minimum(lim.v, np.sqrt(lim.a_lat / np.maximum(k, 1e-12)))
+    return L, np.minimum(vl, lim.v_wheel / (1.0 + k * lim.b / 2.0))
+
+
+def duration(segs: list[tuple], lim: Limits, lead_s: float = 0.5) -> float:
+    """How long build(segs, lim) lasts (s), without building it."""
+    total = lead_s
+    x = y = th = 0.0
+    for kind, mv in _moves(segs):
+        if kind == "spin":
+            L = abs(float(mv[0][1]))
+            v = _passes(L, np.full(max(3, math.ceil(L / 0.002) + 1), lim.w), lim.alpha, lim.alpha)
+        elif kind == "rev":
+            L = -float(mv[0][1])
+            n = max(3, math.ceil(L / DS) + 1)
+            v = _passes(L, np.full(n, min(lim.v, lim.v_wheel)), lim.a, lim.d)
+        else:
+            g = geometry(mv, x, y, th)
+            x, y, th = float(g[-1, 1]), float(g[-1, 2]), float(g[-1, 3])
+            L, vl = _vlim_fwd(g, lim)
+            v = _passes(L, vl, lim.a, lim.d)
+        ds = L / (v.size - 1)
+        total += float(np.sum(2.0 * ds / np.maximum(v[1:] + v[:-1], 1e-9))) + lim.jerk_s
+        total += lim.pause
+    return total
 
 
 def follow(ref: Ref, back_mm: float) -> Ref:

@@ -31,13 +31,13 @@ DLC = {ID_A: 8, ID_B: 8, ID_ROT: 6, ID_LIN: 6}
 
 def _refs(case: dict) -> tuple[list[list[paths.Ref]], list[int]]:
     """Per run: the reference of each driven truck; and its last reference tick."""
-    lim = limits(case)
     rob = case["robot"]
     veh = rob["vehicle"]
     T = case["tick_ms"] / 1000.0
     step = round(T / paths.DT_REF)
     out, ends = [], []
     for p in case["plan"]:
+        lim = limits(case, p)
         segs = [tuple(s) for s in p["segs"]]
         if veh == "clapper":
             L = rob["linkage"]["length_mm"]
@@ -109,14 +109,14 @@ def _start_poses(case, R, rng) -> np.ndarray:
     st[:, 0, :2] = rng.normal(0, fid["placement_mm"], (R, 2))
     st[:, 0, 2] = np.radians(rng.normal(0, fid["placement_deg"], R))
     if veh == "clapper":
-        L = rob["linkage"]["length_mm"] + rng.normal(0, 2.0, R)
-        th = st[:, 0, 2] + np.radians(rng.normal(0, 0.3, R))
+        L = rob["linkage"]["length_mm"] + rng.normal(0, 2 * fid["placement_mm"], R)
+        th = st[:, 0, 2] + np.radians(rng.normal(0, 3 * fid["placement_deg"], R))
         st[:, 1, 0] = st[:, 0, 0] - L * np.cos(th)
         st[:, 1, 1] = st[:, 0, 1] - L * np.sin(th)
-        st[:, 1, 2] = st[:, 0, 2] + np.radians(rng.normal(0, 0.3, R))
+        st[:, 1, 2] = st[:, 0, 2] + np.radians(rng.normal(0, 3 * fid["placement_deg"], R))
     elif veh == "set":
         tr = rob["trailer"]
-        phi = st[:, 0, 2] + np.radians(rng.normal(0, 0.5, R))
+        phi = st[:, 0, 2] + np.radians(rng.normal(0, 5 * fid["placement_deg"], R))
         hx = st[:, 0, 0] - tr["hitch_offset_mm"] * np.cos(st[:, 0, 2])
         hy = st[:, 0, 1] - tr["hitch_offset_mm"] * np.sin(st[:, 0, 2])
         st[:, 1, 0] = hx - tr["trailer_length_mm"] * np.cos(phi)
@@ -193,7 +193,7 @@ def run_world(case: dict, seed: int, progress=None) -> dict:
     step = round(T / paths.DT_REF)
     refs, ends = _refs(case)
     settle = round(case["controller"]["settle_s"] / T)
-    stop = max(2, round(0.6 / T))
+    stop = max(2, round(1.0 / T))  # standing still at the end: what the returns measure
     k_end = np.array(ends) + settle  # last tick with a command
     K = int(k_end.max()) + stop + 1  # ticks simulated
     nt = len(trucks)

@@ -102,8 +102,8 @@ def truck_models(case: dict) -> list[TruckModel]:
         if "tire_compression" in eff:
             e = eff["tire_compression"]
             if e["law"] == "linear":
-                share = np.array([0.5 + e["lateral_offset_mm"] / b, 0.5 - e["lateral_offset_mm"] / b])
-                tm.r0 = tm.r0 - e["k_mm_per_kg"] * e["load_kg"] * share
+                y = e["lateral_offset_mm"] / b  # lever rule: the left wheel carries 1/2 + y
+                tm.r0 = tm.r0 - e["k_mm_per_kg"] * e["load_kg"] * np.array([0.5 + y, 0.5 - y])
         out.append(tm)
     return out
 
@@ -162,8 +162,9 @@ class World:
         self.phi_w = np.zeros((R, nt, 2))  # wheel angle (differs by the backlash)
         self.s_net = np.zeros((R, nt, 2))  # floor-net rolled travel (driven) / horizontal (passive)
         self.u_abs = np.zeros((R, nt, 2))  # unsigned travel for the roughness tables
-        self.vg = np.zeros((R, nt, 2))
-        self.vy = np.zeros((R, nt))
+        self.vg = np.zeros((R, nt, 2))  # ground speed of the contacts (traction law)
+        self.vw_last = np.zeros((R, nt, 2))
+        self.V = np.zeros((R, nt, 2))  # velocity of the truck's centre (friction-circle skid)
         self.U = rough.shape[-1] - 1
         self.rough_flat = [np.ascontiguousarray(rough[:, ti]).reshape(-1) for ti in range(nt)]
         self.rough_base = (np.arange(R)[:, None] * 2 + np.arange(2)[None, :]) * (self.U + 1)
@@ -247,7 +248,7 @@ class World:
     def advance(self, cmd: np.ndarray) -> None:
         """One control tick with wheel speed commands cmd (R, trucks, 2) rad/s (wheel side;
         ignored for a passive trailer)."""
-        R, n, dt = self.R, self.n, self.dt
+        R, n = self.R, self.n
         tabs = self.t + self.tk
         nt = len(self.trucks)
         poses = np.zeros((R, nt, 3, n + 1))
@@ -256,9 +257,9 @@ class World:
         for ti, tm in enumerate(self.trucks):
             if not tm.driven:
                 continue
+            mot = self.motor
             om, ang, acc = laws.motor(
-                self.om[:, ti], cmd[:, ti], self.motor["tau_s"], self.motor["accel_rad_s2"], self.tk,
-                self.decay,
+                self.om[:, ti], cmd[:, ti], mot["tau_s"], mot["accel_rad_s2"], self.tk, self.decay
             )
             self.om[:, ti] = om[..., -1]
             phm = self.phi_m[:, ti, :, None] + ang
@@ -312,9 +313,11 @@ class World:
         amax = e["a_lim_m_s2"] * 1000.0
         along = np.sqrt(np.maximum(amax * amax - alat * alat, (0.05 * amax) ** 2))
         along = np.broadcast_to(along, vw.shape)
-        dv = np.diff(vw, axis=-1, prepend=vg0[..., None])
-        if (np.abs(dv) <= along * dt * (1 - 1e-9)).all() and np.allclose(vg0, vw[..., 0], atol=1e-6):
-            self.vg[:, ti] = vw[..., -1]
+        dv = laws.diff0(vw, self.vw_last[:, ti])
+        self.vw_last[:, ti] = vw[..., -1]
+        gripping = np.abs(vg0 - (vw[..., 0] - dv[..., 0])) < 1e-9  # no spin left from before
+        if (np.abs(dv) <= along * dt).all() and gripping.all():
+            self.vg[:, ti] = vw[..., -1]  # gripping throughout
             return ds
         vg = laws.traction(vw, vg0, along, dt)
         self.vg[:, ti] = vg[..., -1]
@@ -323,7 +326,6 @@ class World:
     def _floor(self, ti: int, ds: np.ndarray, driven: bool) -> np.ndarray:
         """Floor: a driven wheel's rolled travel -> its hub's horizontal progress; a pushed
         (passive) wheel's horizontal progress -> the distance it rolls."""
-        R = self.R
         u = self.u_abs[:, ti, :, None] + np.cumsum(np.abs(ds), axis=-1)
         uu = np.minimum(u, self.U - 1)
         i = uu.astype(np.int64)
@@ -439,18 +441,10 @@ class World:
             else:
                 dth = laws.scrub_torque(dth, dl, dr, b, e["s_sat"], e["r_t_mm"])
         dyb = None
-        if "skid" in eff:
-            e = eff["skid"]
+        skid = eff.get("skid")
+        if skid and skid["law"] == "cornering":  # linear cornering stiffness: sideslip a_lat / c
             alat = (dxb / dt) * (dth / dt)
-            if e["law"] == "cornering":
-                dyb = -dxb * alat / (e["c_alpha_m_s2"] * 1000.0)
-            else:
-                alim = e["a_lim_m_s2"] * 1000.0
-                vy0 = self.vy[:, ti]
-                if (np.abs(alat) > alim).any() or (vy0 != 0).any():
-                    vy = laws.skid_friction(alat, vy0, alim, dt)
-                    self.vy[:, ti] = vy[:, -1]
-                    dyb = vy * dt
+            dyb = -dxb * alat / (skid["c_alpha_m_s2"] * 1000.0)
         if self.castor and ti == 0:
             dth = dth + self._castor(dxb, dth)
         th0 = self.pose[:, ti, 2]
@@ -463,14 +457,33 @@ class World:
         c, s = np.cos(thm), np.sin(thm)
         ds = dxb * (1.0 - dth * dth / 24.0)  # chord of the arc per substep (|dth| < 0.01)
         if dyb is None:
-            np.cumsum(ds * c, axis=-1, out=out[:, 0, 1:])
-            np.cumsum(ds * s, axis=-1, out=out[:, 1, 1:])
+            ddx, ddy = ds * c, ds * s
         else:
-            np.cumsum(ds * c - dyb * s, axis=-1, out=out[:, 0, 1:])
-            np.cumsum(ds * s + dyb * c, axis=-1, out=out[:, 1, 1:])
+            ddx, ddy = ds * c - dyb * s, ds * s + dyb * c
+        if skid and skid["law"] == "friction":
+            ddx, ddy = self._friction(ti, ddx, ddy, skid["a_lim_m_s2"] * 1000.0)
+        np.cumsum(ddx, axis=-1, out=out[:, 0, 1:])
+        np.cumsum(ddy, axis=-1, out=out[:, 1, 1:])
         out[:, 0, 1:] += self.pose[:, ti, 0, None]
         out[:, 1, 1:] += self.pose[:, ti, 1, None]
         return out
+
+    def _friction(self, ti: int, ddx: np.ndarray, ddy: np.ndarray, alim: float):
+        """The friction-circle skid (laws.friction_circle) on the truck's centre; only runs the
+        sequential limiter in ticks where some run's wheels ask for more than the floor gives."""
+        dt = self.dt
+        tx, ty = ddx / dt, ddy / dt
+        v0 = self.V[:, ti]
+        jx = laws.diff0(tx, v0[:, 0])
+        jy = laws.diff0(ty, v0[:, 1])
+        if (np.hypot(jx, jy) <= alim * dt).all():
+            self.V[:, ti, 0], self.V[:, ti, 1] = tx[:, -1], ty[:, -1]
+            return ddx, ddy
+        v = laws.friction_circle(tx, ty, v0, alim, dt)
+        prev = np.concatenate([v0[..., None], v[..., :-1]], axis=-1)
+        mid = (v + prev) * (0.5 * dt)
+        self.V[:, ti] = v[..., -1]
+        return mid[:, 0], mid[:, 1]
 
     def _castor(self, dxb: np.ndarray, dth: np.ndarray) -> np.ndarray:
         """Out of catalog: a trailing castor swivels after every change of the direction of
@@ -558,12 +571,11 @@ class World:
                 self.decoded[:, ti] += d.sum(axis=-1)
                 continue
             if cl["law"] == "rate_limit":
-                fs = cl["f_sample_hz"]
+                fs = cl["f_max_hz"]
                 ph = self.dec_phase[:, ti, :, None]
                 tt = np.concatenate([[tabs[0] - self.dt], tabs])
                 clk = np.floor(tt[None, None, :] * fs + ph)
-                ns = np.maximum(np.diff(clk, axis=-1).astype(np.int64), 1)
-                got, skip = laws.decode_sampling(d, ns)
+                got, skip = laws.decode_saturating(d, np.diff(clk, axis=-1).astype(np.int64))
             else:
                 rate = np.abs(d) / self.dt
                 p = laws.missed_prob(rate, cl["r50_hz"], cl["width_hz"], cl["p_max"])
