@@ -426,10 +426,10 @@ def draw_effect(rng, name: str, case: dict) -> tuple[dict, dict]:
         p["bumps.height_mm"] = float(np.mean([c["h_mm"] for c in e["cables"]]))
     elif name == "roughness":
         if law == "grains":
-            e.update(rate_per_m=_f(rng.uniform(20, 60)), height_mm=_f(rng.uniform(0.25, 0.8)),
+            e.update(rate_per_m=_f(rng.uniform(25, 60)), height_mm=_f(rng.uniform(0.4, 1.0)),
                      shape_w=_f(rng.uniform(2, 6)))
         else:
-            e.update(sigma_mm=_f(rng.uniform(0.15, 0.6)), corr_mm=_f(rng.uniform(4, 15)))
+            e.update(sigma_mm=_f(rng.uniform(0.3, 0.6)), corr_mm=_f(rng.uniform(4, 8)))
     elif name == "slip":
         if law == "accel":
             e.update(k_at_1=_f(rng.uniform(0.02, 0.08)), p=_f(rng.uniform(1.2, 2.5)), cap=0.3,
@@ -592,10 +592,10 @@ def draw_fidelity(rng, rob: dict) -> dict:
 def draw_background(rng) -> dict:
     """The floor every case has: a faint roughness (never zero)."""
     if rng.uniform() < 0.5:
-        return {"law": "grains", "rate_per_m": _f(rng.uniform(10, 40)),
-                "height_mm": _f(rng.uniform(0.03, 0.12)), "shape_w": _f(rng.uniform(2, 6))}
-    return {"law": "surface", "sigma_mm": _f(rng.uniform(0.02, 0.07)),
-            "corr_mm": _f(rng.uniform(3, 12))}
+        return {"law": "grains", "rate_per_m": _f(rng.uniform(15, 40)),
+                "height_mm": _f(rng.uniform(0.05, 0.10)), "shape_w": _f(rng.uniform(2, 6))}
+    return {"law": "surface", "sigma_mm": _f(rng.uniform(0.03, 0.06)),
+            "corr_mm": _f(rng.uniform(3, 8))}
 
 
 # ------------------------------------------------------------------------------------------------
