@@ -111,8 +111,11 @@ def test_drawn_cases_follow_the_mix_and_every_case_has_a_floor() -> None:
         assert sorted(c["effects"]) == c["effects"] and set(c["laws"]) == set(c["effects"])
         for e, law in c["laws"].items():
             assert law in indep.EFFECTS.get(e, [law]) or e in indep.OUT_OF_CATALOG
-    laws_seen = {(e, c["laws"][e]) for c in cs for e in c["effects"] if e in indep.EFFECTS}
-    assert all(len({law for e2, law in laws_seen if e2 == e}) >= 2 for e in indep.EFFECTS)
+    # every catalog effect is drawn in every one of its laws, on a vehicle it applies to
+    for e, laws_ in indep.EFFECTS.items():
+        c = next(c for c in cs if e in cases.catalog_choices(c["vehicle"]))
+        got = {cases.draw_effect(rng, e, json.loads(json.dumps(c)))[0]["law"] for _ in range(30)}
+        assert got == set(laws_) and len(laws_) >= 2, (e, got)
 
 
 def test_drawn_robots_pass_the_repos_robot_validator() -> None:
@@ -184,7 +187,7 @@ def test_eb_scales_spot_turns_by_one_over_eb(tmp_path: Path) -> None:
     tr = io.read_truth(real / "run-spin-01.truth.csv", rob)
     got = tr.pose[-1, 0, 2] - tr.pose[0, 0, 2]
     assert abs(counted - 3 * math.pi) < 0.01  # the robot turned what it was told, by its counts
-    assert abs(got / counted - 1 / eb) < 2e-5
+    assert abs(got / counted - 1 / eb) < 5e-5  # a count's worth
 
 
 @pytest.mark.parametrize("law", ["inv_radius", "torque"])

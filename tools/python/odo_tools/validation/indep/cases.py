@@ -45,7 +45,9 @@ TWO_TRUCK_ONLY = {"rotary_bias": ("clapper", "set"), "link_bias": ("clapper",)}
 DRIVE_EFFECTS = {"slip", "skid", "scrub"}  # act where a motor drives a wheel
 FLOOR_EFFECTS = {"bumps", "roughness"}  # act on every wheel that rolls over the floor
 TICKS_MS = [10, 20, 25, 40, 50, 100]
-COUNTER_BITS = [16, 24, 32]  # what the robot validator accepts today (8-32 is coming)
+# Counter widths drawn: what the repo's robot validator (host_sim robot.c) accepts today; the
+# firmware takes 8-32 already (odo_odometry.h), real decoders have 8, 12, 16, 24 or 32 bits.
+COUNTER_BITS = [16, 24, 32]
 
 
 def _f(x) -> float:
@@ -464,7 +466,9 @@ def draw_effect(rng, name: str, case: dict) -> tuple[dict, dict]:
                 run["v_mm_s"] = _f(min(v, 0.9 * rob["max_wheel_speed_mm_s"]))
     elif name == "scrub":
         if law == "inv_radius":
-            e["c_mm"] = _f((1 if rng.uniform() < 0.8 else -1) * b * rng.uniform(0.0025, 0.015))
+            # either sign: skid-steer-like turns make spot turns the widest (c > 0), while real
+            # robots have also shown arcs wider than spot turns (c < 0, firmware k > 0)
+            e["c_mm"] = _f(_sign(rng) * b * rng.uniform(0.0025, 0.015))
             p["scrub.k"] = -2 * e["c_mm"] / b
         else:
             e.update(s_sat=_f(rng.uniform(0.005, 0.025)), r_t_mm=_f(rng.uniform(1.5, 4) * b / 2))
