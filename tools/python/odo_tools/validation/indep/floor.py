@@ -57,7 +57,7 @@ def obstacle_points(kind: str, h: float, width: float, slope_deg: float, step: f
         c = width / 2
         rho = (c * c + h * h) / (2 * h)
         a0 = math.asin(min(c / rho, 1.0))
-        a = np.linspace(-a0, a0, 200)
+        a = np.linspace(-a0, a0, 81)
         return rho * np.sin(a), rho * np.cos(a) - (rho - h)
     raise ValueError(f"unknown obstacle {kind!r}")
 
@@ -98,7 +98,7 @@ class BumpMap:
 def _map(px: np.ndarray, pz: np.ndarray, R: float, h: float) -> BumpMap:
     reach = math.sqrt(max(2 * R * h - h * h, 0.0))
     lo, hi = float(px.min()) - reach, float(px.max()) + reach
-    n = 4000 if h > 0.05 else 1500
+    n = 3000 if h > 0.05 else 1500
     x = np.linspace(lo - (hi - lo) * 1e-3, hi + (hi - lo) * 1e-3, n)
     yc = envelope(px, pz, R, x)
     on = np.nonzero(yc > 1e-12 * max(h, 1e-3))[0]
@@ -162,7 +162,8 @@ def grains(
     k = rng.poisson(lam * n_mm)
     pos = rng.uniform(0.0, n_mm, k)
     h = rng.rayleigh(h_mm, k)
-    hs, ex, sp = _grain_table(R, shape_w)
+    # the table barely depends on R at this scale: round it so wheels of a truck share one
+    hs, ex, sp = _grain_table(float(f"{R:.2g}"), round(shape_w * 2) / 2)
     e = _loginterp(h, hs, ex)
     span = np.maximum(_loginterp(h, hs, sp), 1.0)
     dens = np.zeros(n_mm + 2)

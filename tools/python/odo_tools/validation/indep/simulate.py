@@ -309,9 +309,11 @@ def write_log(path: Path, case: dict, sim: dict, r: int, epoch: float, rng) -> i
         off += _frame_s(DLC[fid_], fid["can_bitrate"])
         keep = rng.uniform(size=n) >= fid["can_drop_rate"]
         keep[[0, -1]] = True
-        for ti, p in zip(t[keep], pay[keep], strict=True):
-            data = int(p).to_bytes(8, "little")[: DLC[fid_]].hex().upper()
-            lines.append((ti, f"({ti:.6f}) can0 {fid_:03X}#{data}"))
+        hexall = pay[keep].astype("<u8").tobytes().hex().upper()
+        w = 2 * DLC[fid_]
+        head = f"can0 {fid_:03X}#"
+        for i, ti in enumerate(t[keep].tolist()):
+            lines.append((ti, f"({ti:.6f}) {head}{hexall[16 * i : 16 * i + w]}"))
     lines.sort(key=lambda x: x[0])
     path.write_text("\n".join(s for _, s in lines) + "\n")
     return len(lines)
