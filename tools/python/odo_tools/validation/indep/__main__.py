@@ -18,6 +18,36 @@ def _inside(p: Path, folder: Path) -> bool:
     return p == folder or folder in p.parents
 
 
+def plot_tracks(real: Path, png: Path) -> None:
+    """Truth track of every run (truck A, and B of a two-truck vehicle), one panel per run."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    runs = sorted(real.glob("run-*.truth.csv"))
+    n = len(runs)
+    cols = min(4, n)
+    rows = (n + cols - 1) // cols
+    fig, axs = plt.subplots(rows, cols, figsize=(3.2 * cols, 3.2 * rows), squeeze=False)
+    for ax, f in zip(axs.flat, runs, strict=False):
+        d = np.genfromtxt(f, delimiter=",", names=True)
+        ax.plot(d["a_x_mm"] / 1000, d["a_y_mm"] / 1000, lw=0.8, label="A")
+        if "b_x_mm" in d.dtype.names:
+            ax.plot(d["b_x_mm"] / 1000, d["b_y_mm"] / 1000, lw=0.6, label="B")
+        ax.set_title(f.name.replace(".truth.csv", ""), fontsize=8)
+        ax.set_aspect("equal", "datalim")
+        ax.tick_params(labelsize=7)
+    for ax in list(axs.flat)[n:]:
+        ax.axis("off")
+    fig.suptitle(f"{real.name}: motion-capture tracks (m)", fontsize=9)
+    fig.tight_layout()
+    tmp = png.with_name(f".{png.name}.tmp-{os.getpid()}.png")
+    fig.savefig(tmp, dpi=110)
+    plt.close(fig)
+    os.replace(tmp, png)
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(
         prog="python -m odo_tools.validation.indep",
@@ -29,6 +59,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--case", type=int, required=True, help="case number K (0, 1, ...)")
     ap.add_argument("--out", type=Path, required=True, help="folder to create (must not exist)")
     ap.add_argument("--key", type=Path, help="write the case's key (JSON) to this file")
+    ap.add_argument("--plot", type=Path, help="also draw the runs' truth tracks into this PNG "
+                    "(outside --out; it shows only what the recorded data show)")
     ap.add_argument("--quiet", action="store_true", help="no progress output")
     a = ap.parse_args(argv)
     if a.case < 0:
@@ -39,6 +71,10 @@ def main(argv: list[str] | None = None) -> int:
     if not a.out.parent.resolve().is_dir():
         print(f"error: {a.out.parent}: no such folder", file=sys.stderr)
         return 2
+    for what, f in (("--plot", a.plot),):
+        if f is not None and (_inside(f, a.out) or f.exists()):
+            print(f"error: {what} {f}: exists or lies inside --out", file=sys.stderr)
+            return 2
     if a.key is not None:
         if _inside(a.key, a.out):
             print(f"error: --key {a.key} lies inside --out {a.out}: the key must never land "
@@ -67,6 +103,8 @@ def main(argv: list[str] | None = None) -> int:
     if not a.quiet:
         print(f"\rwrote {a.out}: {len(extra['runs'])} runs in {extra['generation_s']:.1f} s",
               file=sys.stderr)
+    if a.plot is not None:
+        plot_tracks(a.out, a.plot)
     if a.key is not None:
         key = dict(case)
         key.update(extra)
