@@ -19,7 +19,8 @@ draw_case(rng, k) -> dict: case k's hidden key. Keys: case, world ("independent"
     robot.json), tick_ms, controller, fidelity (physics step, truth rate/latency/jitter/noise and
     lever arm, return noise, CAN timing), plan (the runs: label, shape, segments, name).
 simulate_case(case, real, seed) -> dict: writes the recorded data into the new folder `real`
-    and returns extra key fields (events: bump hits with run, truck, wheel, x_mm, y_mm, t_s;
+    and returns extra key fields (events: bump hits with run, truck, wheel, x_mm, y_mm (floor
+    frame, the truth's), t_s (robot clock, as the files are stamped), t_run_s, excess_mm;
     runs; link_clamps; generation_s).
 """
 

@@ -398,8 +398,10 @@ def simulate_case(case: dict, real: Path, seed: int, progress=None) -> dict:
         fid = case["fidelity"]
         rets = []
         runs = []
+        epochs = []
         for r, p in enumerate(case["plan"]):
             ep = round(epoch0 + float(sim["t_session"][r]), 3)
+            epochs.append(ep)
             name = p["name"]
             nf = write_log(tmp / f"{name}.log", case, sim, r, ep, rng_log)
             tr = write_truth(tmp / f"{name}.truth.csv", case, sim, r, ep, rng_truth)
@@ -436,7 +438,10 @@ def simulate_case(case: dict, real: Path, seed: int, progress=None) -> dict:
     events = []
     for e in sim["events"]:
         e = dict(e)
-        e["run"] = case["plan"][e.pop("run_index")]["name"]
+        r = e.pop("run_index")
+        e["run"] = case["plan"][r]["name"]
+        e["t_run_s"] = e["t_s"]  # since the run's start
+        e["t_s"] = epochs[r] + e["t_s"]  # the robot's clock, as the log and truth are stamped
         e["truck"] = "AB"[e["truck"]]
         e["wheel"] = ("left", "right")[e["wheel"]]
         events.append(e)
