@@ -644,10 +644,8 @@ def draw_case(rng: np.random.Generator, k: int) -> dict:
         "fidelity": draw_fidelity(rng, rob),
         "true": {
             "mech": {
-                "mass_kg": mass,
-                "load_share": {"A": _f(rng.uniform(0.6, 1.0)), "B": _f(rng.uniform(0.6, 1.0))},
+                "mass_kg": mass,  # what the tyre laws load the wheels with
                 "cg_height_mm": _f(rng.uniform(0.3, 1.0) * b),
-                "cg_lateral_mm": {},
             },
             "motor": {"tau_s": _f(rng.uniform(0.01, 0.06)),
                       "accel_rad_s2": _f(rng.uniform(2500, 5000) /

@@ -50,14 +50,10 @@ class TruckModel:
     r0: np.ndarray  # true static rolling radii (left, right), mm
     b: float  # true geometric wheelbase, mm
     eff: dict = field(default_factory=dict)
-    mass_kg: float = 0.0  # load on this truck's two wheels
-    cg_lat_mm: float = 0.0
-    cg_h_mm: float = 0.0
 
 
 def truck_models(case: dict) -> list[TruckModel]:
     rob = case["robot"]
-    mech = case["true"]["mech"]
     names = ["A"] if rob["vehicle"] == "labmate" else ["A", "B"]
     out = []
     for nm in names:
@@ -82,7 +78,6 @@ def truck_models(case: dict) -> list[TruckModel]:
             b *= e["value"] if e["law"] == "fixed" else e["value0"]
         if "scrub" in eff and eff["scrub"]["law"] == "torque":
             b *= 1.0 - eff["scrub"]["s_sat"]
-        m = mech["mass_kg"] * (mech["load_share"][nm])
         tm = TruckModel(
             nm,
             driven,
@@ -95,9 +90,6 @@ def truck_models(case: dict) -> list[TruckModel]:
             r0,
             b,
             eff,
-            m,
-            mech["cg_lateral_mm"].get(nm, 0.0),
-            mech["cg_height_mm"],
         )
         if "tire_compression" in eff:
             e = eff["tire_compression"]
@@ -253,7 +245,6 @@ class World:
         nt = len(self.trucks)
         poses = np.zeros((R, nt, 3, n + 1))
         enc = np.zeros((R, nt, 2, n))
-        dh_all = {}
         for ti, tm in enumerate(self.trucks):
             if not tm.driven:
                 continue
@@ -283,7 +274,6 @@ class World:
                 else:
                     ds = self._traction(ti, ds, r, om, e)
             dh = self._floor(ti, ds, driven=True)
-            dh_all[ti] = dh
             poses[:, ti] = self._integrate(ti, dh, tabs)
         if self.vehicle == "set":
             poses[:, 1], enc[:, 1] = self._trailer(poses[:, 0], tabs)
