@@ -19,6 +19,14 @@ function(odo_host_flags target)
   odo_sanitize(${target})
 endfunction()
 
+# The strict set (libcanard's) for host C that is held to it: hal/, hostlib/ and the host tools.
+set(ODO_STRICT_WARNINGS
+  -Wconversion -Wsign-conversion -Wdouble-promotion -Wswitch-enum -Wundef -Wcast-align)
+
+function(odo_strict_flags target)
+  target_compile_options(${target} PRIVATE ${ODO_STRICT_WARNINGS})
+endfunction()
+
 # ASan+UBSan for the host preset. Benchmarks and the Python-loaded library opt out by not calling it.
 function(odo_sanitize target)
   if(ODO_SANITIZE)
