@@ -56,3 +56,35 @@ bool odo_cli_long(const char *prog, const char *name, const char *value, long lo
 }
 
 void odo_cli_usage_hint(const char *prog) { fprintf(stderr, "%s: see %s --help\n", prog, prog); }
+
+bool odo_cli_split_equals(int *argc, char ***argv)
+{
+    const int n = *argc;
+    char **in = *argv;
+    size_t extra = 0;
+    for (int i = 1; i < n; ++i) {
+        extra += strncmp(in[i], "--", 2) == 0 && strchr(in[i], '=') != NULL;
+    }
+    if (extra == 0U) {
+        return true;
+    }
+    char **out = calloc((size_t)n + extra + 1U, sizeof *out);
+    if (out == NULL) {
+        return false;
+    }
+    int k = 0;
+    for (int i = 0; i < n; ++i) {
+        char *eq = (i > 0 && strncmp(in[i], "--", 2) == 0) ? strchr(in[i], '=') : NULL;
+        if (eq == NULL) {
+            out[k++] = in[i];
+            continue;
+        }
+        *eq = '\0'; /* argv strings are ours to modify (C99 5.1.2.2.1) */
+        out[k++] = in[i];
+        out[k++] = eq + 1;
+    }
+    out[k] = NULL;
+    *argc = k;
+    *argv = out;
+    return true;
+}

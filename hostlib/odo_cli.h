@@ -38,6 +38,11 @@ bool odo_cli_seed(const char *prog, const char *value, uint64_t *seed);
 /// A decimal integer in [lo, hi] for option NAME. false with a message otherwise.
 bool odo_cli_long(const char *prog, const char *name, const char *value, long lo, long hi, long *out);
 
+/// For the CLIs whose options take lists (odo-calib fit --runs A B ...) and so parse by hand: split
+/// every "--name=value" argument into "--name" "value", as getopt_long reads it. Replaces *argv
+/// with a new array (allocated once for the process' life); false only when out of memory.
+bool odo_cli_split_equals(int *argc, char ***argv);
+
 /// getopt_long's "unknown option / missing value" has been printed; add the pointer to --help.
 void odo_cli_usage_hint(const char *prog);
 

@@ -14,6 +14,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "odo_cli.h"
 #include "odo/odo_app.h"
 #include "odo_refcheck.h"
 #include "odo_synth.h"
@@ -28,6 +29,7 @@ static void usage(FILE *f)
 {
     fprintf(f,
             "usage: odo-bench [--json] [--quick]\n"
+            "       odo-bench --help | --version\n"
             "\n"
             "Prints the firmware's benchmark figures:\n"
             "  pos_err_mm_1km, heading_err_rad_1km  fixed point vs double after 1 km of mixed\n"
@@ -215,6 +217,9 @@ int main(int argc, char **argv)
             quick = 1;
         } else if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
             usage(stdout);
+            return 0;
+        } else if (strcmp(argv[i], "--version") == 0) {
+            odo_cli_print_version("odo-bench");
             return 0;
         } else {
             fprintf(stderr, "odo-bench: unknown argument '%s'\n\n", argv[i]);

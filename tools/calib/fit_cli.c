@@ -63,35 +63,6 @@ static int take_list(int argc, char **argv, int *i, const char **dst, size_t *n,
     return 0;
 }
 
-/* Is `out` one of the inputs: the robot file, or a file a --runs folder holds that fit reads? */
-static int is_input(const char *out, const char *robot, const char *const *runs, size_t n_runs)
-{
-    char ro[PATH_MAX], rr[PATH_MAX], dir[PATH_MAX], rd[PATH_MAX], rdir[PATH_MAX];
-    if (realpath(robot, rr) != NULL && realpath(out, ro) != NULL && strcmp(ro, rr) == 0) {
-        return 1;
-    }
-    snprintf(dir, sizeof dir, "%s", out);
-    char *slash = strrchr(dir, '/');
-    const char *base = slash != NULL ? slash + 1 : out;
-    if (slash != NULL) {
-        *slash = '\0';
-    } else {
-        snprintf(dir, sizeof dir, ".");
-    }
-    if (realpath(dir, rd) == NULL) {
-        return 0;
-    }
-    const int read_by_fit = strcmp(base, "robot.json") == 0 || strcmp(base, "returns.csv") == 0 ||
-                            (strncmp(base, "run-", 4) == 0 && (strstr(base, ".log") != NULL ||
-                                                               strstr(base, ".truth.csv") != NULL));
-    for (size_t k = 0; k < n_runs && read_by_fit; ++k) {
-        if (realpath(runs[k], rdir) != NULL && strcmp(rdir, rd) == 0) {
-            return 1;
-        }
-    }
-    return 0;
-}
-
 typedef struct {
     double before_pos, after_pos, before_th, after_th;
     size_t n;
@@ -169,10 +140,25 @@ int calib_fit_main(int argc, char **argv)
             fprintf(stderr, "odo-calib fit: --out-params %s: name it .json or .bin\n", outs[k]);
             return 2;
         }
-        if (is_input(outs[k], robot, runs, n_runs)) {
-            fprintf(stderr, "odo-calib fit: --out-params %s is an input (the robot description or a file of "
-                            "a --runs folder)\n", outs[k]);
-            return 1;
+    }
+    /* Inputs never become outputs (hostlib/odo_out.h): the robot file, and anything inside a --runs folder. */
+    odo_out_inputs_t ins;
+    odo_out_inputs_init(&ins);
+    {
+        char ierr[256];
+        (void)odo_out_inputs_add(&ins, robot, ierr, sizeof ierr);
+        for (size_t k = 0; k < n_runs; ++k) {
+            if (odo_out_inputs_add(&ins, runs[k], ierr, sizeof ierr) != 0) {
+                fprintf(stderr, "odo-calib fit: %s\n", ierr);
+                return 2;
+            }
+        }
+        for (size_t k = 0; k < n_out; ++k) {
+            char oerr[PATH_MAX + 256];
+            if (odo_out_check_inputs(&ins, outs[k], oerr, sizeof oerr) != 0) {
+                fprintf(stderr, "odo-calib fit: --out-params %s\n", oerr);
+                return 1;
+            }
         }
     }
 
@@ -280,7 +266,7 @@ int calib_fit_main(int argc, char **argv)
     }
 
     for (size_t k = 0; k < n_out && rc == 0; ++k) {
-        if (calib_write_params(outs[k], &pb) != 0) {
+        if (calib_write_params(outs[k], &pb, &ins) != 0) {
             rc = 1;
         }
     }

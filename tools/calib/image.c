@@ -1,5 +1,6 @@
 /// Firmware image formats. See image.h.
 #include "image.h"
+#include "odo_out.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -470,7 +471,8 @@ static void put_hex(uint8_t *p, unsigned v)
     p[1] = (uint8_t)d[v & 0xF];
 }
 
-int img_write_patched(const img_t *img, const uint8_t block[ODO_PARAMS_SIZE], const char *out_path, char *err,
+int img_write_patched(const img_t *img, const uint8_t block[ODO_PARAMS_SIZE], const char *out_path,
+                      const odo_out_inputs_t *ins, char *err,
                       size_t errlen)
 {
     if (img->block_len != ODO_PARAMS_SIZE) {
@@ -509,63 +511,37 @@ int img_write_patched(const img_t *img, const uint8_t block[ODO_PARAMS_SIZE], co
         memcpy(out + img->block_file_off, block, ODO_PARAMS_SIZE);
     }
 
-    const size_t plen = strlen(out_path);
-    char *tmp = malloc(plen + 32);
-    if (tmp == NULL) {
-        free(out);
-        snprintf(err, errlen, "out of memory");
-        return -1;
-    }
-    snprintf(tmp, plen + 32, "%s.tmp.%ld", out_path, (long)getpid());
+    /* hostlib/odo_out.h: a fresh temp beside out_path (O_EXCL|O_NOFOLLOW), never a special file. */
     int rc = -1;
-    const int fd = open(tmp, O_WRONLY | O_CREAT | O_EXCL, 0600);
-    if (fd < 0) {
-        snprintf(err, errlen, "cannot create %s: %s", tmp, strerror(errno));
+    odo_out_file_t o;
+    if (odo_out_file_begin(&o, out_path, ins, err, errlen) != 0) {
         goto done;
     }
-    size_t left = img->file_len;
-    const uint8_t *p = out;
-    while (left > 0) {
-        const ssize_t w = write(fd, p, left);
-        if (w < 0 && errno == EINTR) {
-            continue;
-        }
-        if (w <= 0) {
-            snprintf(err, errlen, "cannot write %s: %s", tmp, strerror(errno));
-            close(fd);
-            unlink(tmp);
-            goto done;
-        }
-        p += w;
-        left -= (size_t)w;
-    }
-    if (fsync(fd) != 0 || fchmod(fd, (mode_t)(img->mode ? img->mode : 0644)) != 0 || close(fd) != 0) {
-        snprintf(err, errlen, "cannot finish %s: %s", tmp, strerror(errno));
-        unlink(tmp);
+    if (fwrite(out, 1, img->file_len, o.f) != img->file_len || fflush(o.f) != 0 ||
+        fchmod(fileno(o.f), (mode_t)(img->mode ? img->mode : 0644)) != 0) {
+        snprintf(err, errlen, "cannot write %s: %s", out_path, strerror(errno));
+        odo_out_file_abort(&o);
         goto done;
     }
     /* Read it back the way a user would, before it replaces anything. */
     img_t back;
     char berr[256];
-    if (img_load(tmp, &back, berr, sizeof berr) != 0 || back.status != ODO_PARAMS_OK ||
+    if (img_load(o.tmp, &back, berr, sizeof berr) != 0 || back.status != ODO_PARAMS_OK ||
         memcmp(back.block, block, ODO_PARAMS_SIZE) != 0) {
         snprintf(err, errlen, "internal error: the patched image does not read back (%s)",
                  back.file == NULL ? berr : "block differs");
         if (back.file != NULL) {
             img_free(&back);
         }
-        unlink(tmp);
+        odo_out_file_abort(&o);
         goto done;
     }
     img_free(&back);
-    if (rename(tmp, out_path) != 0) {
-        snprintf(err, errlen, "cannot rename %s to %s: %s", tmp, out_path, strerror(errno));
-        unlink(tmp);
+    if (odo_out_file_commit(&o, err, errlen) != 0) {
         goto done;
     }
     rc = 0;
 done:
-    free(tmp);
     free(out);
     return rc;
 }

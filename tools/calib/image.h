@@ -24,6 +24,7 @@
 #include <stdint.h>
 
 #include "odo/odo_params.h"
+#include "odo_out.h"
 
 typedef enum { IMG_BIN = 0, IMG_HEX = 1, IMG_ELF = 2 } img_format_t;
 
@@ -61,10 +62,11 @@ const char *img_format_name(img_format_t f);
 
 /// Write the image with `block` (a current-version block, ODO_PARAMS_SIZE bytes) in place of the
 /// old one to `out_path`: a temporary file in the same directory, flushed, read back and checked,
-/// then renamed over out_path (keeping the source file's permission bits). Refused (-1) when the
-/// image holds a block of another size (a version-1 image). On any error nothing but the old
-/// state remains. Returns 0, or -1.
-int img_write_patched(const img_t *img, const uint8_t block[ODO_PARAMS_SIZE], const char *out_path, char *err,
-                      size_t errlen);
+/// then renamed over out_path (keeping the source file's permission bits), by hostlib/odo_out.h's
+/// rule: out_path must be absent or a regular file, and neither one of `ins` (may be NULL) nor
+/// inside an input folder. Refused (-1) when the image holds a block of another size (a version-1
+/// image). On any error nothing but the old state remains. Returns 0, or -1.
+int img_write_patched(const img_t *img, const uint8_t block[ODO_PARAMS_SIZE], const char *out_path,
+                      const odo_out_inputs_t *ins, char *err, size_t errlen);
 
 #endif

@@ -7,6 +7,7 @@
 /// destination keeps its old content.
 #include <errno.h>
 #include <fcntl.h>
+#include <getopt.h>
 #include <inttypes.h>
 #include <math.h>
 #include <stdio.h>
@@ -19,6 +20,8 @@
 #include "calib_core.h"
 #include "fit_cli.h"
 #include "image.h"
+#include "odo_cli.h"
+#include "odo_out.h"
 #include "params_diag.h"
 #include "params_json.h"
 #include "returns_csv.h"
@@ -35,6 +38,7 @@ static void usage(FILE *f)
 {
     fprintf(f,
             "usage: odo-calib <command> [options]      (odo-calib <command> --help for details)\n"
+            "       odo-calib --help | --version\n"
             "\n"
             "  umbmark --returns returns.csv --side-mm 4000 (--robot R.json | --params P.json|P.bin)\n"
             "          [--robot R.json --params P] [--method paper|exact] [--json] [--out-params P.json|P.bin]\n"
@@ -67,26 +71,34 @@ typedef struct {
     const char *value;
 } opt_t;
 
+/// getopt_long over the table (so --name=value works too); argv[-1] is the command's name.
 static int parse_opts(const char *cmd, int argc, char **argv, opt_t *o, size_t n)
 {
-    for (int i = 0; i < argc; ++i) {
-        size_t k = 0;
-        while (k < n && strcmp(argv[i], o[k].name) != 0) {
-            k++;
-        }
-        if (k == n) {
-            fprintf(stderr, "%s %s: unknown argument '%s' (see %s %s --help)\n", k_prog, cmd, argv[i], k_prog, cmd);
+    struct option lo[16];
+    if (n >= sizeof lo / sizeof lo[0]) {
+        return -1;
+    }
+    for (size_t k = 0; k < n; ++k) {
+        lo[k].name = o[k].name + 2; /* "--image" -> "image" */
+        lo[k].has_arg = o[k].takes_value ? required_argument : no_argument;
+        lo[k].flag = NULL;
+        lo[k].val = (int)k;
+    }
+    memset(&lo[n], 0, sizeof lo[n]);
+    optind = 1;
+    opterr = 0;
+    for (int c; (c = getopt_long(argc + 1, argv - 1, ":", lo, NULL)) != -1;) {
+        if (c == '?' || c == ':') {
+            fprintf(stderr, "%s %s: %s '%s' (see %s %s --help)\n", k_prog, cmd,
+                    c == ':' ? "missing value for" : "unknown argument", argv[optind - 2], k_prog, cmd);
             return -1;
         }
-        if (o[k].takes_value) {
-            if (i + 1 >= argc) {
-                fprintf(stderr, "%s %s: %s needs a value\n", k_prog, cmd, argv[i]);
-                return -1;
-            }
-            o[k].value = argv[++i];
-        } else {
-            o[k].value = "1";
-        }
+        o[c].value = o[c].takes_value ? optarg : "1";
+    }
+    if (optind < argc + 1) {
+        fprintf(stderr, "%s %s: unexpected argument '%s' (see %s %s --help)\n", k_prog, cmd, argv[optind - 1],
+                k_prog, cmd);
+        return -1;
     }
     return 0;
 }
@@ -107,50 +119,24 @@ static int ends_with(const char *s, const char *suf)
     return a >= b && strcmp(s + a - b, suf) == 0;
 }
 
-/// Write a text or binary output atomically: path.tmp.<pid>, fsync, rename.
-static int write_atomic(const char *path, const void *data, size_t len)
+/// Write an output by hostlib/odo_out.h's rule (temp beside it, fsync, rename; never an input).
+static int write_atomic(const char *path, const void *data, size_t len, const odo_out_inputs_t *ins)
 {
-    char tmp[4096];
-    if (snprintf(tmp, sizeof tmp, "%s.tmp.%ld", path, (long)getpid()) >= (int)sizeof tmp) {
-        fprintf(stderr, "%s: output path too long\n", k_prog);
-        return -1;
-    }
-    const int fd = open(tmp, O_WRONLY | O_CREAT | O_EXCL, 0644);
-    if (fd < 0) {
-        fprintf(stderr, "%s: cannot create %s: %s\n", k_prog, tmp, strerror(errno));
-        return -1;
-    }
-    const uint8_t *p = data;
-    size_t left = len;
-    while (left > 0) {
-        const ssize_t w = write(fd, p, left);
-        if (w < 0 && errno == EINTR) {
-            continue;
-        }
-        if (w <= 0) {
-            fprintf(stderr, "%s: cannot write %s: %s\n", k_prog, tmp, strerror(errno));
-            close(fd);
-            unlink(tmp);
-            return -1;
-        }
-        p += w;
-        left -= (size_t)w;
-    }
-    if (fsync(fd) != 0 || close(fd) != 0 || rename(tmp, path) != 0) {
-        fprintf(stderr, "%s: cannot write %s: %s\n", k_prog, path, strerror(errno));
-        unlink(tmp);
+    char err[PATH_MAX + 256];
+    if (odo_out_write(path, data, len, ins, err, sizeof err) != 0) {
+        fprintf(stderr, "%s: %s\n", k_prog, err);
         return -1;
     }
     return 0;
 }
 
 /// Parameters as JSON text (malloc'd) or as the 128-byte block, by the output's extension.
-int calib_write_params(const char *path, const odo_params_t *p)
+int calib_write_params(const char *path, const odo_params_t *p, const odo_out_inputs_t *ins)
 {
     if (ends_with(path, ".bin")) {
         uint8_t block[ODO_PARAMS_SIZE];
         (void)odo_params_encode(p, block, sizeof block);
-        return write_atomic(path, block, sizeof block);
+        return write_atomic(path, block, sizeof block, ins);
     }
     char *buf = NULL;
     size_t len = 0;
@@ -160,7 +146,7 @@ int calib_write_params(const char *path, const odo_params_t *p)
         fprintf(stderr, "%s: out of memory\n", k_prog);
         return -1;
     }
-    const int rc = write_atomic(path, buf, len);
+    const int rc = write_atomic(path, buf, len, ins);
     free(buf);
     return rc;
 }
@@ -322,7 +308,12 @@ static int cmd_umbmark(int argc, char **argv)
     if (out != NULL) {
         odo_params_t np;
         calib_apply(&in_force, &c, &np);
-        if (calib_write_params(out, &np) != 0) {
+        odo_out_inputs_t ins; /* --out-params equal to --returns (or the robot, the block) is refused */
+        odo_out_inputs_init(&ins);
+        (void)odo_out_inputs_add(&ins, returns_path, err, sizeof err);
+        (void)odo_out_inputs_add(&ins, robot, err, sizeof err);
+        (void)odo_out_inputs_add(&ins, params, err, sizeof err);
+        if (calib_write_params(out, &np, &ins) != 0) {
             return EXIT_FAIL;
         }
     }
@@ -396,7 +387,12 @@ static int cmd_write(int argc, char **argv)
     }
     uint8_t block[ODO_PARAMS_SIZE];
     (void)odo_params_encode(&p, block, sizeof block);
-    const int rc = img_write_patched(&img, block, out != NULL ? out : image, err, sizeof err);
+    /* The block file is an input: --out equal to --params is refused. The image itself is the
+     * documented in-place default, so it is not. */
+    odo_out_inputs_t ins;
+    odo_out_inputs_init(&ins);
+    (void)odo_out_inputs_add(&ins, params, err, sizeof err);
+    const int rc = img_write_patched(&img, block, out != NULL ? out : image, &ins, err, sizeof err);
     if (rc != 0) {
         fprintf(stderr, "%s write: %s\n", k_prog, err);
     } else {
@@ -591,6 +587,13 @@ static int cmd_export(int argc, char **argv)
 
 int main(int argc, char **argv)
 {
+    if (!odo_cli_split_equals(&argc, &argv)) {
+        return EXIT_FAIL;
+    }
+    if (argc >= 2 && strcmp(argv[1], "--version") == 0) {
+        odo_cli_print_version(k_prog);
+        return 0;
+    }
     if (argc < 2 || is_help(argv[1])) {
         usage(argc < 2 ? stderr : stdout);
         return argc < 2 ? EXIT_USAGE : 0;

@@ -15,6 +15,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "odo_cli.h"
 #include "odo/odo_can.h"
 
 #define LINE_MAX_CHARS 1024
@@ -23,7 +24,7 @@
 #define CAN_ERR_FLAG_IN_ID 0x20000000UL
 
 static const char usage_text[] =
-    "usage: odo-canvec [--help]\n"
+    "usage: odo-canvec [--help | --version]\n"
     "\n"
     "Reads commands from stdin, one per line, and answers each on stdout with the firmware's own\n"
     "CAN codec (odo_can.h), so the codec can be checked against can/odometry.dbc in bulk.\n"
@@ -491,6 +492,10 @@ int main(int argc, char **argv)
     for (int i = 1; i < argc; i++) {
         if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
             fputs(usage_text, stdout);
+            return 0;
+        }
+        if (strcmp(argv[i], "--version") == 0) {
+            odo_cli_print_version("odo-canvec");
             return 0;
         }
         fprintf(stderr, "odo-canvec: unexpected argument '%s'\n\n%s", argv[i], usage_text);

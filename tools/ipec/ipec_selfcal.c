@@ -30,23 +30,21 @@ void ipec_apply_params(sim_robot_t *r, const odo_params_t *p)
     }
 }
 
-int ipec_write_params(const char *path, const odo_params_t *p)
+/// Finish the params JSON begun with odo_out_file_begin (hostlib/odo_out.h); aborts it when p is NULL.
+int ipec_write_params(odo_out_file_t *o, const odo_params_t *p)
 {
-    char tmp[4096];
-    snprintf(tmp, sizeof tmp, "%s.tmp.%ld", path, (long)getpid());
-    FILE *f = fopen(tmp, "w");
-    if (f == NULL) {
-        fprintf(stderr, "odo-ipec: cannot write %s\n", tmp);
+    char err[4096 + 256];
+    if (p == NULL) {
+        odo_out_file_abort(o);
         return -1;
     }
-    if (odo_params_json_write(f, p) != 0 || fclose(f) != 0) {
-        fprintf(stderr, "odo-ipec: cannot write %s\n", tmp);
-        remove(tmp);
+    if (odo_params_json_write(o->f, p) != 0) {
+        fprintf(stderr, "odo-ipec: cannot write %s\n", o->path);
+        odo_out_file_abort(o);
         return -1;
     }
-    if (rename(tmp, path) != 0) {
-        fprintf(stderr, "odo-ipec: cannot rename %s to %s\n", tmp, path);
-        remove(tmp);
+    if (odo_out_file_commit(o, err, sizeof err) != 0) {
+        fprintf(stderr, "odo-ipec: %s\n", err);
         return -1;
     }
     return 0;
@@ -371,10 +369,25 @@ int ipec_cmd_selfcal(int argc, char **argv, int link)
     if (load_start("clapper", robot_path, scenario, params, &robot, &sc, &start) != 0) {
         return 1;
     }
+    /* The output is checked (and its temp made) before the runs: an input is never overwritten. */
+    char err[4096 + 256];
+    odo_out_inputs_t ins;
+    odo_out_inputs_init(&ins);
+    (void)odo_out_inputs_add(&ins, robot_path, err, sizeof err);
+    (void)odo_out_inputs_add(&ins, scenario, err, sizeof err);
+    (void)odo_out_inputs_add(&ins, params, err, sizeof err);
+    odo_out_file_t of;
+    if (odo_out_file_begin(&of, out, &ins, err, sizeof err) != 0) {
+        fprintf(stderr, "odo-ipec: %s\n", err);
+        return 1;
+    }
     if (!link) {
         static ipec_selfcal_t r;
-        if (ipec_selfcal(&robot, &sc, exp, (unsigned)runs, ipec, (uint64_t)seed, &r) != 0 ||
-            ipec_write_params(out, &r.params) != 0) {
+        if (ipec_selfcal(&robot, &sc, exp, (unsigned)runs, ipec, (uint64_t)seed, &r) != 0) {
+            odo_out_file_abort(&of);
+            return 1;
+        }
+        if (ipec_write_params(&of, &r.params) != 0) {
             return 1;
         }
         printf("{\n  \"experiment\": \"%s\", \"runs_per_direction\": %ld, \"params\": \"%s\",\n  \"truck\": [\n", exp, runs,
@@ -391,7 +404,11 @@ int ipec_cmd_selfcal(int argc, char **argv, int link)
         return 0;
     }
     static ipec_selfcal_link_t r;
-    if (ipec_selfcal_link(&robot, &sc, &start, &r) != 0 || ipec_write_params(out, &r.params) != 0) {
+    if (ipec_selfcal_link(&robot, &sc, &start, &r) != 0) {
+        odo_out_file_abort(&of);
+        return 1;
+    }
+    if (ipec_write_params(&of, &r.params) != 0) {
         return 1;
     }
     printf("{\n  \"params\": \"%s\",\n  \"alpha_bias_deg\": %.4f, \"beta_bias_deg\": %.4f, \"length_bias_mm\": %.4f,\n"

@@ -2,6 +2,7 @@
 #ifndef IPEC_TOOL_H
 #define IPEC_TOOL_H
 
+#include "odo_out.h"
 #include <stdbool.h>
 #include <stdint.h>
 
@@ -29,8 +30,9 @@ int ipec_cmd_goals(int argc, char **argv);
 
 /// The robot's calibration fields (Ed, Eb, Es per truck; link biases) from a parameter block.
 void ipec_apply_params(sim_robot_t *r, const odo_params_t *p);
-/// Write a parameter block as JSON (params_json.h) through a temp file and a rename. 0 or -1.
-int ipec_write_params(const char *path, const odo_params_t *p);
+/// Write a parameter block as JSON (params_json.h) into the output begun with odo_out_file_begin
+/// and commit it (hostlib/odo_out.h); p NULL aborts it. 0 or -1 (message on stderr).
+int ipec_write_params(odo_out_file_t *o, const odo_params_t *p);
 
 /// 004 s. 5.1: Ed and Eb of both trucks from IPEC's corrections (odo_selfcal.h) over `runs` cw and
 /// `runs` ccw runs of `exp`, then the same runs again with the estimate (the "after" figures).

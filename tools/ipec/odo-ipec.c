@@ -9,12 +9,14 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "odo_cli.h"
 #include "ipec_tool.h"
 
 static void usage(FILE *f)
 {
     fprintf(f,
             "usage: odo-ipec goals [--runs N] [--quick]\n"
+            "       odo-ipec --help | --version\n"
             "       odo-ipec trace --experiment E --vehicle clapper|set [--ipec off|paper|estimator]\n"
             "                      [--scenario S.json] [--robot R.json] [--ccw] [--bumps N] [--run K] [--seed S]\n"
             "       odo-ipec selfcal --scenario S.json --out P.json [--robot R.json] [--params P0.json]\n"
@@ -223,6 +225,13 @@ static int cmd_trace(int argc, char **argv)
 
 int main(int argc, char **argv)
 {
+    if (!odo_cli_split_equals(&argc, &argv)) {
+        return 1;
+    }
+    if (argc >= 2 && strcmp(argv[1], "--version") == 0) {
+        odo_cli_print_version("odo-ipec");
+        return 0;
+    }
     if (argc < 2 || strcmp(argv[1], "--help") == 0 || strcmp(argv[1], "-h") == 0) {
         usage(argc < 2 ? stderr : stdout);
         return argc < 2 ? 2 : 0;

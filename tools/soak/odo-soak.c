@@ -7,12 +7,14 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "odo_cli.h"
 #include "soak.h"
 
 static void usage(FILE *f)
 {
     fprintf(f,
             "usage: odo-soak [--json] [--quick] [--ticks N] [--seed S]\n"
+            "       odo-soak --help | --version\n"
             "\n"
             "Replays a seeded labmate drive through odo-replay's tick assembler and the firmware's\n"
             "step twice, clean and through a faulty bus, and prints how far the faulty run's pose\n"
@@ -52,9 +54,15 @@ int main(int argc, char **argv)
     int json = 0, quick = 0;
     soak_config_t soak;
     soak_defaults(&soak);
+    if (!odo_cli_split_equals(&argc, &argv)) {
+        return 1;
+    }
     for (int i = 1; i < argc; ++i) {
         if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
             usage(stdout);
+            return 0;
+        } else if (strcmp(argv[i], "--version") == 0) {
+            odo_cli_print_version("odo-soak");
             return 0;
         } else if (strcmp(argv[i], "--json") == 0) {
             json = 1;
