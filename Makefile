@@ -4,7 +4,7 @@ SHELL := /bin/bash
 .DEFAULT_GOAL := help
 JOBS ?= $(shell nproc)
 
-.PHONY: help deps build release cm4 test demo bench soak clean
+.PHONY: help deps build release cm4 test demo bench soak fuzz coverage clean
 
 help: ## list targets
 	@grep -E '^[a-z0-9-]+:.*## ' $(MAKEFILE_LIST) | awk -F':.*## ' '{printf "  make %-8s %s\n", $$1, $$2}'
@@ -35,6 +35,9 @@ bench: release ## print benchmark figures as JSON (-O2 build: build/release/bin/
 
 soak: release ## frame loss at speed and the 24 h fault soak, JSON (build/release/bin/odo-soak --json)
 	@build/release/bin/odo-soak --json
+
+fuzz: deps ## long libFuzzer campaigns, 10^7 execs per harness (FUZZ_RUNS=N to change), JSON (fuzz/README.md)
+	@python3 fuzz/campaign.py --runs $(or $(FUZZ_RUNS),10000000)
 
 clean: ## remove build output (keeps .venv)
 	rm -rf build

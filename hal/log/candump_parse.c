@@ -99,8 +99,11 @@ candump_result_t candump_parse_line(const char *line, size_t len, candump_line_t
     p++;
     size_t n = 0U;
     while (p < end && *p != ' ') {
-        if (n >= CANDUMP_IFACE_MAX || is_blank(*p) || *p == '(' || *p == ')') {
-            FAIL("interface name must be 1 to 15 characters, without blanks or parentheses");
+        /* Printable ASCII only: a NUL or control byte would cut or garble the name the outputs
+         * carry (found by fuzz/fuzz_candump: "(1.0) \0\a0 178#..." read back as an empty name). */
+        if (n >= CANDUMP_IFACE_MAX || is_blank(*p) || *p == '(' || *p == ')' || (unsigned char)*p < 0x21U ||
+            (unsigned char)*p > 0x7EU) {
+            FAIL("interface name must be 1 to 15 printable characters, without blanks or parentheses");
         }
         out->iface[n++] = *p++;
     }

@@ -156,7 +156,10 @@ size_t candump_format_line(char *buf, uint64_t t_us, const char *iface, const od
     }
     *p++ = '#';
     if ((f->flags & ODO_CAN_FLAG_RTR) != 0U) {
-        *p++ = 'R';
+        *p++ = 'R'; /* and the requested length, as can-utils writes it ("#R3"); found by fuzz_candump */
+        if (f->dlc > 0U && f->dlc <= 8U) {
+            *p++ = (char)('0' + f->dlc);
+        }
     } else {
         for (uint8_t k = 0U; k < f->dlc && k < 8U; ++k) {
             *p++ = HEX[f->data[k] >> 4];

@@ -24,18 +24,44 @@ BIN = BUILD / "bin"
 SIM, CALIB, PARAMS, REPLAY = (BIN / n for n in ("odo-sim", "odo-calib", "odo-params", "odo-replay"))
 NONE = SRC / "host_sim" / "scenarios" / "none.json"
 ROBOT = SRC / "host_sim" / "robots" / "labmate.json"
-C_CLIS = ["odo-sim", "odo-replay", "odo-calib", "odo-params", "odo-ipec", "odo-canvec", "odo-demo",
-          "odo-bench", "odo-soak"]
+C_CLIS = [
+    "odo-sim",
+    "odo-replay",
+    "odo-calib",
+    "odo-params",
+    "odo-ipec",
+    "odo-canvec",
+    "odo-demo",
+    "odo-bench",
+    "odo-soak",
+]
 
 
-def run(*args: object, cwd: Path | None = None, timeout: int = 300) -> subprocess.CompletedProcess[str]:
-    return subprocess.run([str(a) for a in args], capture_output=True, text=True, cwd=cwd,
-                          timeout=timeout)
+def run(
+    *args: object, cwd: Path | None = None, timeout: int = 300
+) -> subprocess.CompletedProcess[str]:
+    return subprocess.run(
+        [str(a) for a in args], capture_output=True, text=True, cwd=cwd, timeout=timeout
+    )
 
 
 def sim(out: object, *extra: object, cwd: Path | None = None) -> subprocess.CompletedProcess[str]:
-    return run(SIM, "--experiment", "rect-7x4", "--vehicle", "labmate", "--scenario", NONE,
-               "--runs", "1", "--quiet", "--out", out, *extra, cwd=cwd)
+    return run(
+        SIM,
+        "--experiment",
+        "rect-7x4",
+        "--vehicle",
+        "labmate",
+        "--scenario",
+        NONE,
+        "--runs",
+        "1",
+        "--quiet",
+        "--out",
+        out,
+        *extra,
+        cwd=cwd,
+    )
 
 
 def temps(folder: Path) -> list[str]:
@@ -45,8 +71,20 @@ def temps(folder: Path) -> list[str]:
 @pytest.fixture(scope="module")
 def returns(tmp_path_factory: pytest.TempPathFactory) -> Path:
     d = tmp_path_factory.mktemp("umb")
-    r = run(SIM, "--experiment", "umbmark", "--vehicle", "labmate", "--scenario",
-            SRC / "host_sim" / "scenarios" / "set-sim.json", "--runs", "2", "--quiet", "--out", d / "u")
+    r = run(
+        SIM,
+        "--experiment",
+        "umbmark",
+        "--vehicle",
+        "labmate",
+        "--scenario",
+        SRC / "host_sim" / "scenarios" / "set-sim.json",
+        "--runs",
+        "2",
+        "--quiet",
+        "--out",
+        d / "u",
+    )
     assert r.returncode == 0, r.stderr
     return d / "u" / "returns.csv"
 
@@ -61,6 +99,7 @@ def block(tmp_path: Path) -> Path:
 
 # --- the CLI vocabulary ------------------------------------------------------------------------
 
+
 @pytest.mark.parametrize("tool", C_CLIS)
 def test_every_c_cli_prints_the_cmake_project_version(tool: str) -> None:
     version = re.search(r"project\(odometry VERSION (\S+)", (SRC / "CMakeLists.txt").read_text())
@@ -74,12 +113,26 @@ def test_every_c_cli_prints_the_cmake_project_version(tool: str) -> None:
 
 def test_ipec_takes_the_same_values_in_odo_sim_and_odo_replay(tmp_path: Path) -> None:
     clapper = SRC / "host_sim" / "robots" / "clapper.json"
-    r = run(SIM, "--experiment=straight-36m", "--vehicle=clapper", f"--scenario={NONE}", "--runs=1",
-            "--bumps=0", "--quiet", f"--out={tmp_path / 's'}")
+    r = run(
+        SIM,
+        "--experiment=straight-36m",
+        "--vehicle=clapper",
+        f"--scenario={NONE}",
+        "--runs=1",
+        "--bumps=0",
+        "--quiet",
+        f"--out={tmp_path / 's'}",
+    )
     assert r.returncode == 0, r.stderr
     for mode in ("off", "on", "paper", "estimator"):
-        r = run(REPLAY, f"--log={tmp_path / 's' / 'run-fwd-01.log'}", f"--robot={clapper}",
-                f"--ipec={mode}", "--quiet", f"--out={tmp_path / mode}")
+        r = run(
+            REPLAY,
+            f"--log={tmp_path / 's' / 'run-fwd-01.log'}",
+            f"--robot={clapper}",
+            f"--ipec={mode}",
+            "--quiet",
+            f"--out={tmp_path / mode}",
+        )
         assert r.returncode == 0, (mode, r.stderr)
     for tool in (SIM, REPLAY):
         r = run(tool, "--ipec=sideways")
@@ -93,11 +146,22 @@ def test_seed_minus_one_is_a_usage_error_everywhere() -> None:
 
 # --- issue 16's reproducers --------------------------------------------------------------------
 
+
 def test_readme_first_simulator_command_works_without_an_out_folder(tmp_path: Path) -> None:
     """README: `odo-sim --experiment umbmark ... --out out/umbmark` on a fresh clone (no out/)."""
-    r = run(SIM, "--experiment", "umbmark", "--vehicle", "labmate", "--scenario",
-            SRC / "host_sim" / "scenarios" / "set-sim.json", "--out", "out/umbmark", "--quiet",
-            cwd=tmp_path)
+    r = run(
+        SIM,
+        "--experiment",
+        "umbmark",
+        "--vehicle",
+        "labmate",
+        "--scenario",
+        SRC / "host_sim" / "scenarios" / "set-sim.json",
+        "--out",
+        "out/umbmark",
+        "--quiet",
+        cwd=tmp_path,
+    )
     assert r.returncode == 0, r.stderr
     assert (tmp_path / "out" / "umbmark" / "returns.csv").is_file()
     assert temps(tmp_path) == []
@@ -133,17 +197,36 @@ def test_fit_out_params_inside_a_runs_folder_is_refused(tmp_path: Path) -> None:
     runs = tmp_path / "runs"
     (runs / "square").mkdir(parents=True)
     (runs / "square" / "run-01.log").write_text("(0.000000) can0 110#0000000000000000\n")
-    r = run(CALIB, "fit", "--runs", runs, "--robot", ROBOT, "--out-params", runs / "square" / "p.json")
+    r = run(
+        CALIB, "fit", "--runs", runs, "--robot", ROBOT, "--out-params", runs / "square" / "p.json"
+    )
     assert r.returncode == 1 and "inside the input folder" in r.stderr
-    r = run(CALIB, "fit", "--runs", runs, "--robot", ROBOT, "--out-params", ROBOT.with_suffix(".json"))
+    r = run(
+        CALIB, "fit", "--runs", runs, "--robot", ROBOT, "--out-params", ROBOT.with_suffix(".json")
+    )
     assert r.returncode == 1 and "also an input" in r.stderr
     assert sorted(p.name for p in (runs / "square").iterdir()) == ["run-01.log"]
 
 
 def test_sim_killed_mid_run_leaves_no_temp(tmp_path: Path) -> None:
-    p = subprocess.Popen([str(SIM), "--experiment", "umbmark", "--vehicle", "labmate", "--scenario",
-                          str(NONE), "--runs", "100", "--quiet", "--out", str(tmp_path / "a" / "b")],
-                         stderr=subprocess.PIPE, text=True)
+    p = subprocess.Popen(
+        [
+            str(SIM),
+            "--experiment",
+            "umbmark",
+            "--vehicle",
+            "labmate",
+            "--scenario",
+            str(NONE),
+            "--runs",
+            "100",
+            "--quiet",
+            "--out",
+            str(tmp_path / "a" / "b"),
+        ],
+        stderr=subprocess.PIPE,
+        text=True,
+    )
     deadline = time.monotonic() + 60
     while time.monotonic() < deadline and not list(tmp_path.rglob("run-cw-01.log")):
         time.sleep(0.05)
@@ -155,8 +238,18 @@ def test_sim_killed_mid_run_leaves_no_temp(tmp_path: Path) -> None:
 
 def test_calib_umbmark_out_params_equal_to_returns_is_refused(returns: Path) -> None:
     before = returns.read_bytes()
-    r = run(CALIB, "umbmark", "--returns", returns, "--side-mm", "4000", "--robot", ROBOT,
-            "--out-params", returns)
+    r = run(
+        CALIB,
+        "umbmark",
+        "--returns",
+        returns,
+        "--side-mm",
+        "4000",
+        "--robot",
+        ROBOT,
+        "--out-params",
+        returns,
+    )
     assert r.returncode == 1 and "also an input" in r.stderr
     assert returns.read_bytes() == before
     assert temps(returns.parent) == []
@@ -169,13 +262,17 @@ def test_calib_write_out_equal_to_params_is_refused(tmp_path: Path, block: Path)
     r = run(CALIB, "write", "--image", image, "--params", block, "--out", block)
     assert r.returncode == 1 and "also an input" in r.stderr
     assert block.read_bytes() == before
-    r = run(CALIB, "write", "--image", image, "--params", block, f"--out={tmp_path / 'new' / 'fw.bin'}")
+    r = run(
+        CALIB, "write", "--image", image, "--params", block, f"--out={tmp_path / 'new' / 'fw.bin'}"
+    )
     assert r.returncode == 0, r.stderr
     assert (tmp_path / "new" / "fw.bin").read_bytes() == image.read_bytes()
 
 
 @pytest.mark.parametrize("kind", ["fifo", "symlink", "folder"])
-def test_calib_out_params_on_a_special_file_is_refused(tmp_path: Path, returns: Path, kind: str) -> None:
+def test_calib_out_params_on_a_special_file_is_refused(
+    tmp_path: Path, returns: Path, kind: str
+) -> None:
     """Was: --out-params /dev/full replaced the device node with a regular file (as root)."""
     target = tmp_path / "special"
     victim = tmp_path / "victim.json"
@@ -186,8 +283,18 @@ def test_calib_out_params_on_a_special_file_is_refused(tmp_path: Path, returns: 
         target.symlink_to(victim)
     else:
         target.mkdir()
-    r = run(CALIB, "umbmark", "--returns", returns, "--side-mm", "4000", "--robot", ROBOT,
-            "--out-params", target)
+    r = run(
+        CALIB,
+        "umbmark",
+        "--returns",
+        returns,
+        "--side-mm",
+        "4000",
+        "--robot",
+        ROBOT,
+        "--out-params",
+        target,
+    )
     assert r.returncode == 1 and str(target) in r.stderr and "refusing" in r.stderr, r.stderr
     mode = target.lstat().st_mode
     assert {"fifo": stat.S_ISFIFO, "symlink": stat.S_ISLNK, "folder": stat.S_ISDIR}[kind](mode)

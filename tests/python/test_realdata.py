@@ -370,7 +370,7 @@ def test_fit_from_return_poses_only(tmp_path: Path) -> None:
     ("glob", "'nothing*' matches no run"),
     ("backwards", "does not increase"),
     ("short_truth", "mismatched ticks/truth lengths"),
-    ("out_is_input", "is an input"),
+    ("out_is_input", "inside the input folder"),
 ])
 def test_fit_bad_input(synthetic, tmp_path: Path, case: str, expect: str) -> None:
     imp, robot = synthetic

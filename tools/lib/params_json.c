@@ -7,6 +7,7 @@
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include "params_diag.h"
 
@@ -179,7 +180,12 @@ static char *slurp(const char *path, size_t *len, char *err, size_t errlen)
         snprintf(err, errlen, "%s: cannot open: %s", path, strerror(errno));
         return NULL;
     }
-    const size_t cap = 1U << 20;
+    /* As large as the file (up to the 1 MiB cap), not the cap each time. */
+    struct stat sb;
+    const size_t limit = 1U << 20;
+    const size_t cap = (fstat(fileno(f), &sb) == 0 && sb.st_size >= 0 && (uint64_t)sb.st_size < limit)
+                           ? (size_t)sb.st_size + 1U
+                           : limit;
     char *buf = malloc(cap + 1U);
     if (buf == NULL) {
         fclose(f);
@@ -189,8 +195,9 @@ static char *slurp(const char *path, size_t *len, char *err, size_t errlen)
     const size_t n = fread(buf, 1, cap + 1U, f);
     const int bad = ferror(f);
     fclose(f);
-    if (bad || n > cap) {
-        snprintf(err, errlen, bad ? "%s: read error" : "%s: larger than 1 MiB, not a parameter file", path);
+    if (bad || n > limit || (n == cap && cap < limit)) { /* over the cap, or grew while read */
+        snprintf(err, errlen, bad ? "%s: read error" : n > limit ? "%s: larger than 1 MiB, not a parameter file"
+                                                                : "%s: changed while it was read", path);
         free(buf);
         return NULL;
     }
