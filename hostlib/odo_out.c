@@ -144,7 +144,8 @@ static int fail(char *err, size_t errlen, const char *fmt, ...)
 
 static const char *kind_of(mode_t m)
 {
-    return S_ISDIR(m)    ? "a folder"
+    return S_ISREG(m)    ? "a file"
+           : S_ISDIR(m)  ? "a folder"
            : S_ISLNK(m)  ? "a symbolic link"
            : S_ISFIFO(m) ? "a FIFO"
            : S_ISCHR(m)  ? "a character device"

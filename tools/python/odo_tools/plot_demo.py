@@ -17,14 +17,30 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
+from .outpath import OutputError, out_file
+
 
 def read_pose(path: Path) -> dict[str, np.ndarray]:
     """Columns of an odo-demo pose.csv as float arrays, keyed by header name."""
-    with path.open(newline="") as f:
-        rows = list(csv.reader(f))
+    try:
+        with path.open(newline="", encoding="utf-8") as f:
+            rows = list(csv.reader(f))
+    except UnicodeDecodeError as e:
+        line = path.read_bytes()[: e.start].count(b"\n") + 1
+        raise ValueError(f"{path}:{line}: not UTF-8 text") from None
     if len(rows) < 2:
         raise ValueError(f"{path}: no data rows")
+    for i, r in enumerate(rows[1:], start=2):
+        if len(r) != len(rows[0]):
+            raise ValueError(f"{path}:{i}: {len(r)} fields, expected {len(rows[0])}")
+        try:
+            [float(x) for x in r]
+        except ValueError:
+            raise ValueError(f"{path}:{i}: not a number") from None
     header, data = rows[0], np.array(rows[1:], dtype=float)
+    for need in ("x_mm", "y_mm", "true_x_mm", "true_y_mm"):
+        if need not in header:
+            raise ValueError(f"{path}:1: no column {need} (an odo-demo pose.csv?)")
     return {name: data[:, i] for i, name in enumerate(header)}
 
 
@@ -55,10 +71,11 @@ def plot(runs: dict[str, Path], out: Path) -> None:
     zoom.grid(True, alpha=0.3)
     zoom.legend(fontsize=8)
     fig.tight_layout()
-    out.parent.mkdir(parents=True, exist_ok=True)
-    tmp = out.with_suffix(".tmp.png")
-    fig.savefig(tmp, dpi=110)
-    tmp.replace(out)
+    try:  # the output rule (odo_tools/outpath.py): temp beside it, renamed; never an input
+        with out_file(out, list(runs.values()), "wb") as f:
+            fig.savefig(f, format="png", dpi=110)
+    finally:
+        plt.close(fig)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -75,7 +92,7 @@ def main(argv: list[str] | None = None) -> int:
         runs[name] = Path(path)
     try:
         plot(runs, args.out)
-    except (OSError, ValueError) as e:
+    except (OSError, ValueError, OutputError) as e:
         print(f"odo-plot-demo: {e}", file=sys.stderr)
         return 1
     print(f"odo-plot-demo: wrote {args.out}")

@@ -21,6 +21,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
+from .outpath import OutputError, out_file
+
 
 def load_truth(p: Path) -> np.ndarray:
     try:
@@ -70,7 +72,7 @@ def main(argv: list[str] | None = None) -> int:
         metavar="NAME=TRUTH,BEFORE,AFTER",
         help="a panel: name, the run's truth CSV, odo-replay poses.csv before and after",
     )
-    ap.add_argument("--out", required=True, help="PNG to write (temporary file, then renamed)")
+    ap.add_argument("--out", required=True, help="PNG to write (a temp beside it, then renamed)")
     a = ap.parse_args(argv)
     panels = []
     for spec in a.run:
@@ -80,8 +82,6 @@ def main(argv: list[str] | None = None) -> int:
             ap.error(f"--run {spec!r}: expected NAME=TRUTH,BEFORE,AFTER")
         panels.append((name, *(Path(p) for p in parts)))
     out = Path(a.out)
-    if out.resolve() in [p.resolve() for pn in panels for p in pn[1:]]:
-        ap.error("--out is one of the inputs")
     n = len(panels)
     fig, axes = plt.subplots(
         2, n, figsize=(4.2 * n, 7.4), squeeze=False, gridspec_kw={"height_ratios": [3, 1.4]}
@@ -115,9 +115,14 @@ def main(argv: list[str] | None = None) -> int:
     axes[1, 0].legend(fontsize=7, loc="upper left")
     fig.suptitle("Held-out runs: motion capture vs the firmware replaying the logs", fontsize=11)
     fig.tight_layout()
-    tmp = out.with_name(out.name + ".tmp.png")
-    fig.savefig(tmp, dpi=110)
-    tmp.rename(out)
+    try:  # the output rule (odo_tools/outpath.py): temp beside it, renamed; never an input
+        with out_file(out, [p for pn in panels for p in pn[1:]], "wb") as f:
+            fig.savefig(f, format="png", dpi=110)
+    except (OutputError, OSError) as e:
+        print(f"odo-plot-realdata: {e}", file=sys.stderr)
+        return 1
+    finally:
+        plt.close(fig)
     print(f"odo-plot-realdata: wrote {out}", file=sys.stderr)
     return 0
 

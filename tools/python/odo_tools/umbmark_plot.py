@@ -19,14 +19,22 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
+from .outpath import OutputError, out_file
+
 COLUMNS = ["run", "direction", "x_abs_mm", "y_abs_mm", "theta_abs_deg", "x_calc_mm",
            "y_calc_mm", "theta_calc_deg"]
 
 
 def read_returns(path: Path) -> dict[str, np.ndarray]:
     """Return errors (000 Eq. 3.1) per direction: {"cw": (n, 2) array of (ex, ey) mm, ...}."""
-    with path.open(newline="") as f:
-        rows = [r for r in csv.reader(f) if r and not r[0].startswith("#")]
+    try:
+        with path.open(newline="", encoding="utf-8") as f:
+            rows = [r for r in csv.reader(f) if r and not r[0].startswith("#")]
+    except UnicodeDecodeError as e:
+        line = path.read_bytes()[: e.start].count(b"\n") + 1
+        raise ValueError(f"{path}:{line}: not UTF-8 text") from None
+    except csv.Error as e:
+        raise ValueError(f"{path}: not a CSV table: {e}") from None
     if not rows or rows[0] != COLUMNS:
         raise ValueError(f"{path}:1: header must be {','.join(COLUMNS)}")
     out: dict[str, list[tuple[float, float]]] = {"cw": [], "ccw": []}
@@ -40,6 +48,8 @@ def read_returns(path: Path) -> dict[str, np.ndarray]:
         if not np.all(np.isfinite(v)):
             raise ValueError(f"{path}:{lineno}: values must be finite")
         out[r[1]].append((v[0] - v[3], v[1] - v[4]))
+    if not out["cw"] and not out["ccw"]:
+        raise ValueError(f"{path}: no runs (a header and no rows)")
     return {d: np.array(p, dtype=float).reshape(-1, 2) for d, p in out.items()}
 
 
@@ -100,13 +110,14 @@ def main(argv: list[str] | None = None) -> int:
         a.legend(fontsize=8, loc="best")
         a.grid(True, lw=0.3)
     fig.tight_layout()
-    tmp = args.out.with_name(args.out.name + ".tmp.png")
-    try:
-        fig.savefig(tmp, dpi=110)
-        tmp.replace(args.out)
+    try:  # the output rule (odo_tools/outpath.py): temp beside it, renamed; never an input
+        with out_file(args.out, [args.before, args.after], "wb") as f:
+            fig.savefig(f, format="png", dpi=110)
+    except OutputError as e:
+        print(f"odo-plot-umbmark: {e}", file=sys.stderr)
+        return 1
     except OSError as e:
-        print(f"odo-plot-umbmark: cannot write {args.out}: {e}", file=sys.stderr)
-        tmp.unlink(missing_ok=True)
+        print(f"odo-plot-umbmark: cannot write {args.out}: {e.strerror or e}", file=sys.stderr)
         return 1
     finally:
         plt.close(fig)
