@@ -11,20 +11,21 @@ function(odo_firmware_flags target)
     "SHELL:-include ${CMAKE_SOURCE_DIR}/firmware/src/odo_fw.h")
 endfunction()
 
-# Host C (tools, HAL backends, tests): warnings as errors, C99 with POSIX.1-2008/XSI (M_PI,
-# rename, fsync, clock_gettime).
-function(odo_host_flags target)
-  target_compile_options(${target} PRIVATE -Wall -Wextra -Wshadow -Werror)
-  target_compile_definitions(${target} PRIVATE _XOPEN_SOURCE=700)
-  odo_sanitize(${target})
-endfunction()
-
-# The strict set (libcanard's) for host C that is held to it: hal/, hostlib/ and the host tools.
+# The strict set (libcanard's) for host C too (hal/, hostlib/, host_sim/, tools/,
+# tests/): every host target gets it through odo_host_flags or its perf twin.
 set(ODO_STRICT_WARNINGS
   -Wconversion -Wsign-conversion -Wdouble-promotion -Wswitch-enum -Wundef -Wcast-align)
 
 function(odo_strict_flags target)
   target_compile_options(${target} PRIVATE ${ODO_STRICT_WARNINGS})
+endfunction()
+
+# Host C (tools, HAL backends, tests): warnings as errors, C99 with POSIX.1-2008/XSI (M_PI,
+# rename, fsync, clock_gettime).
+function(odo_host_flags target)
+  target_compile_options(${target} PRIVATE -Wall -Wextra -Wshadow -Werror ${ODO_STRICT_WARNINGS})
+  target_compile_definitions(${target} PRIVATE _XOPEN_SOURCE=700)
+  odo_sanitize(${target})
 endfunction()
 
 # ASan+UBSan for the host preset. Benchmarks and the Python-loaded library opt out by not calling it.

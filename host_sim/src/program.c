@@ -98,12 +98,12 @@ int sim_program_build(const char *experiment, int ccw, int bumps, double bump_he
     int rc = 0;
     if (strcmp(experiment, "umbmark") == 0) {
         umbmark(out);
-        rc = spread_bumps(out, bumps < 0 ? 0 : bumps, 0.0, 4000.0, out->ccw ? ODO_LEFT : ODO_RIGHT,
+        rc = spread_bumps(out, bumps < 0 ? 0 : bumps, 0.0, 4000.0, (uint8_t)(out->ccw ? ODO_LEFT : ODO_RIGHT),
                           bump_height_mm);
     } else if (strcmp(experiment, "umbmark-ext") == 0) {
         /* 000 s. 3.4: the bumps go under the wheel facing the inside of the square, on leg 1. */
         umbmark(out);
-        rc = spread_bumps(out, bumps < 0 ? 10 : bumps, 0.0, 4000.0, out->ccw ? ODO_LEFT : ODO_RIGHT,
+        rc = spread_bumps(out, bumps < 0 ? 10 : bumps, 0.0, 4000.0, (uint8_t)(out->ccw ? ODO_LEFT : ODO_RIGHT),
                           bump_height_mm);
     } else if (strcmp(experiment, "straight-36m") == 0) {
         /* 004 s. 6.1: out 18 m, stop, back 18 m driving backward; bumps under the right wheels on

@@ -60,12 +60,12 @@ static void multipliers_follow_eqs_2_1_6_33_6_34_and_6_28(void)
     const double b_eff = eb * 340.0;
     /* within half an LSB of the Q40 format (plus the reference's own rounding) */
     const double half_lsb = 0.5 / 1099511627776.0 + 1e-15;
-    TEST_ASSERT_DOUBLE_WITHIN(half_lsb, kl, m.dist_mm_q40[0] / 1099511627776.0);
-    TEST_ASSERT_DOUBLE_WITHIN(half_lsb, kr, m.dist_mm_q40[1] / 1099511627776.0);
+    TEST_ASSERT_DOUBLE_WITHIN(half_lsb, kl, (double)m.dist_mm_q40[0] / 1099511627776.0);
+    TEST_ASSERT_DOUBLE_WITHIN(half_lsb, kr, (double)m.dist_mm_q40[1] / 1099511627776.0);
     TEST_ASSERT_DOUBLE_WITHIN(1e-9, ed, (double)m.dist_mm_q40[1] / (double)m.dist_mm_q40[0]);
     const double tl = kl / (2.0 * M_PI * b_eff), tr = kr / (2.0 * M_PI * b_eff);
-    TEST_ASSERT_DOUBLE_WITHIN(1e-12 * tl, tl, m.turn_q64[0] / 18446744073709551616.0);
-    TEST_ASSERT_DOUBLE_WITHIN(1e-12 * tr, tr, m.turn_q64[1] / 18446744073709551616.0);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-12 * tl, tl, (double)m.turn_q64[0] / 18446744073709551616.0);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-12 * tr, tr, (double)m.turn_q64[1] / 18446744073709551616.0);
     /* max counts: 3 m/s for 40 ms over the smaller k, plus one */
     TEST_ASSERT_UINT32_WITHIN(1U, (uint32_t)ceil(120.0 / kl) + 1U, m.max_counts);
 }

@@ -937,7 +937,7 @@ static void encoder_puts_every_field_at_its_table_offset(void)
         for (uint8_t t = 0; t < (f->scope == ODO_PSCOPE_TRUCK ? ODO_TRUCKS : 1U); t++) {
             uint32_t raw = 0;
             for (unsigned k = f->width; k > 0; k--) {
-                raw = (raw << 8) | b[f->offset + t * f->stride + k - 1];
+                raw = (raw << 8) | b[f->offset + (size_t)t * f->stride + k - 1U];
             }
             const int64_t want = odo_params_get(&p, (odo_param_field_t)f->id, t);
             const int64_t got = f->type == ODO_PTYPE_I32 ? (int64_t)(int32_t)raw : (int64_t)raw;

@@ -124,7 +124,7 @@ static void paper_model_round_trip_recovers_ed_and_eb_of_the_set_robot(void)
     TEST_ASSERT_DOUBLE_WITHIN(2e-6, 2.0 / (ed + 1.0), q30(c.cl_q30));        /* Eq. 6.33 */
     TEST_ASSERT_DOUBLE_WITHIN(2e-6, 2.0 / (1.0 / ed + 1.0), q30(c.cr_q30));  /* Eq. 6.34 */
     /* Eq. 6.23: R = (L/2) / sin(beta/2), negative for a right-curving leg. */
-    TEST_ASSERT_DOUBLE_WITHIN(1.0, 2000.0 / sin(beta / 2.0), c.radius_um / 1000.0);
+    TEST_ASSERT_DOUBLE_WITHIN(1.0, 2000.0 / sin(beta / 2.0), (double)c.radius_um / 1000.0);
     /* The mean wheel diameter is kept (Eq. 6.30): cL + cR = 2. */
     TEST_ASSERT_DOUBLE_WITHIN(3e-9, 2.0, q30(c.cl_q30) + q30(c.cr_q30));
 }

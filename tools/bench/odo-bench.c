@@ -162,7 +162,7 @@ static double now_s(void)
 {
     struct timespec ts;
     clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + ts.tv_nsec * 1e-9;
+    return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
 }
 
 /// The 10-run UMBmark set (5 cw, 5 ccw) of the 000 s. 4.6.2 robot (b 337 vs 340 mm, Ed 0.9985,

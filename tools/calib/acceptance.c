@@ -152,7 +152,7 @@ static int cmp_double(const void *a, const void *b)
 static double median(double *v, size_t n)
 {
     qsort(v, n, sizeof *v, cmp_double);
-    return n == 0 ? NAN : (n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]));
+    return n == 0 ? (double)NAN : (n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]));
 }
 
 static int make_scenario(sim_scenario_t *sc, double ed, double eb, double es, int rough, uint64_t seed, char *err,

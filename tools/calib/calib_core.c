@@ -54,8 +54,8 @@ int calib_umbmark(const returns_t *r, double side_mm, const odo_params_t *in_for
         const umb_setup_t su = {side_um / 1000.0, b_nom, out->ed_in_force, out->eb_in_force};
         const double cg[2][2] = {{out->st.cg_x_um[0] / 1000.0, out->st.cg_y_um[0] / 1000.0},
                                  {out->st.cg_x_um[1] / 1000.0, out->st.cg_y_um[1] / 1000.0}};
-        if (umb_exact_fit(&su, cg, out->paper.ed_q30 / Q30, out->paper.b_actual_nm / 1e6, &out->fit, err,
-                          errlen) != 0) {
+        if (umb_exact_fit(&su, cg, out->paper.ed_q30 / Q30, (double)out->paper.b_actual_nm / 1e6, &out->fit, err,
+                          errlen > UINT32_MAX ? UINT32_MAX : (unsigned)errlen) != 0) {
             return -1;
         }
         const double ed = out->fit.ed * Q30, eb = out->fit.b_mm / b_nom * Q30;

@@ -171,7 +171,7 @@ static void print_calib_json(FILE *f, const calib_result_t *c, const char *retur
                "\"radius_mm\": %.1f,\n",
             p->alpha_bam * BAM_DEG, p->beta_bam * BAM_DEG, p->alpha_x_bam * BAM_DEG, p->alpha_y_bam * BAM_DEG,
             p->beta_x_bam * BAM_DEG, p->beta_y_bam * BAM_DEG, p->alpha_disagree_bam * BAM_DEG,
-            p->beta_disagree_bam * BAM_DEG, p->radius_um / 1000.0);
+            p->beta_disagree_bam * BAM_DEG, (double)p->radius_um / 1000.0);
     fprintf(f, " \"runs_cw\": %u, \"runs_ccw\": %u, \"cg_cw_mm\": [%.3f, %.3f], \"cg_ccw_mm\": [%.3f, %.3f], "
                "\"r_cg_cw_mm\": %.3f, \"r_cg_ccw_mm\": %.3f,\n",
             s->n[0], s->n[1], s->cg_x_um[0] / 1000.0, s->cg_y_um[0] / 1000.0, s->cg_x_um[1] / 1000.0,

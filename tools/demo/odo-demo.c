@@ -154,8 +154,8 @@ int main(int argc, char **argv)
                 odo_candump_write(lf, t_us, "vcan0", &hal.tx[f]);
             }
             const odo_pose_t *pose = &out.pose[0];
-            fprintf(pf, "%.3f,%.4f,%.4f,%.6f,%.4f,%.4f,%.6f\n", t_us * 1e-6, pose->x_mm_q32 / 4294967296.0,
-                    pose->y_mm_q32 / 4294967296.0, (double)(int32_t)odo_heading_bam(pose) * (360.0 / 4294967296.0),
+            fprintf(pf, "%.3f,%.4f,%.4f,%.6f,%.4f,%.4f,%.6f\n", (double)t_us * 1e-6, (double)pose->x_mm_q32 / 4294967296.0,
+                    (double)pose->y_mm_q32 / 4294967296.0, (double)(int32_t)odo_heading_bam(pose) * (360.0 / 4294967296.0),
                     real.x_mm, real.y_mm, real.theta_rad * 180.0 / M_PI);
             t_us += p.tick_us;
         }
@@ -172,7 +172,7 @@ int main(int argc, char **argv)
         return 1;
     }
     const odo_pose_t *pose = &out.pose[0];
-    const double xc = pose->x_mm_q32 / 4294967296.0, yc = pose->y_mm_q32 / 4294967296.0;
+    const double xc = (double)pose->x_mm_q32 / 4294967296.0, yc = (double)pose->y_mm_q32 / 4294967296.0;
     const double thc = (double)(int32_t)odo_heading_bam(pose) * (360.0 / 4294967296.0);
     printf("odo-demo: %s square, %u ticks, %u frames published\n", ccw ? "ccw" : "cw", app.ticks,
            app.ticks * 3U);

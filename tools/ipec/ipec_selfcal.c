@@ -127,7 +127,7 @@ int ipec_selfcal(const sim_robot_t *robot, const sim_scenario_t *sc, const char 
         out->eb[i] = out->params.truck[i].eb_q30 / TWO30;
         out->have_ed[i] = res.have_ed[i];
         out->have_eb[i] = res.have_eb[i];
-        out->straight_m[i] = before.cal.truck[i].straight_um / 1e6;
+        out->straight_m[i] = (double)before.cal.truck[i].straight_um / 1e6;
         out->turn_deg[i] = ipec_bam_deg(before.cal.truck[i].turn_bam);
         out->corr_deg_per_m[i] = ipec_bam_deg(res.corr_per_m_bam[i]);
         out->corr_deg_per_turn[i] = ipec_bam_deg(res.corr_per_turn_bam[i]);

@@ -84,8 +84,8 @@ START_TEST(raw_image_refusals_name_the_problem)
 
     img[0x104] = 3; /* version 3, CRC recomputed: another layout */
     const uint32_t crc = odo_crc32(img + 0x100, ODO_PARAMS_CRC_OFFSET);
-    for (int k = 0; k < 4; ++k) {
-        img[0x100 + ODO_PARAMS_CRC_OFFSET + k] = (uint8_t)(crc >> (8 * k));
+    for (unsigned k = 0; k < 4U; ++k) {
+        img[0x100 + ODO_PARAMS_CRC_OFFSET + k] = (uint8_t)(crc >> (8U * k));
     }
     put(path, img, sizeof img);
     ck_assert_int_eq(img_load(path, &m, err, sizeof err), -1);
