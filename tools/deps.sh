@@ -11,6 +11,8 @@ APT_PACKAGES=(
   valgrind                                                         # odo-bench instruction counts
   libjansson-dev                                                   # host_sim robot/scenario JSON
   qemu-system-x86 busybox-static cpio can-utils                     # vcan test: Debian kernel under qemu
+  qemu-system-arm                                                  # target tests: Cortex-M4 boards under qemu
+  openocd                                                          # make flash; its config check in ctest
 )
 
 missing=()
