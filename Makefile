@@ -4,10 +4,10 @@ SHELL := /bin/bash
 .DEFAULT_GOAL := help
 JOBS ?= $(shell nproc)
 
-.PHONY: help deps build release cm4 test demo bench clean
+.PHONY: help deps build release cm4 test demo bench bench-target flash flash-params clean
 
 help: ## list targets
-	@grep -E '^[a-z0-9-]+:.*## ' $(MAKEFILE_LIST) | awk -F':.*## ' '{printf "  make %-8s %s\n", $$1, $$2}'
+	@grep -E '^[a-z0-9-]+:.*## ' $(MAKEFILE_LIST) | awk -F':.*## ' '{printf "  make %-12s %s\n", $$1, $$2}'
 
 deps: ## install Debian packages and the pinned Python venv (.venv)
 	@bash tools/deps.sh
@@ -32,6 +32,9 @@ demo: build ## run the main job on built-in sample data
 
 bench: release ## print benchmark figures as JSON (-O2 build: build/release/bin/odo-bench --json)
 	@build/release/bin/odo-bench --json
+
+bench-target: release cm4 ## Cortex-M4 figures as JSON: instructions per tick (emulated), flash, RAM, stack
+	@.venv/bin/odo-bench-target --build-dir build/release --cm4-dir build/cm4
 
 clean: ## remove build output (keeps .venv)
 	rm -rf build

@@ -197,7 +197,7 @@ def run_selftest(args: argparse.Namespace) -> int:
             deadline = time.monotonic() + args.timeout
             while True:
                 vals = struct.unpack(SELFTEST_FMT, qmp.read_mem(addr, size))
-                got = dict(zip(SELFTEST_KEYS, vals))
+                got = dict(zip(SELFTEST_KEYS, vals, strict=True))
                 if got["done"] == SELFTEST_DONE:
                     break
                 if time.monotonic() > deadline:
@@ -206,7 +206,7 @@ def run_selftest(args: argparse.Namespace) -> int:
                 time.sleep(0.1)
         finally:
             proc.kill()
-            out, _ = proc.communicate()
+            proc.communicate()
         fmt = {"faults_or": "0x{:08x}", "heading_bam": "0x{:08x}", "done": "0x{:08x}"}
         got_s = {k: fmt.get(k, "{}").format(v) for k, v in got.items()}
         print(f"netduinoplus2 ({args.params} parameter block): " +
