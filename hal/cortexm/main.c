@@ -1,10 +1,6 @@
-/// Cortex-M4 image entry: boot the application on the parameter block in flash, run a short
-/// synthetic self-test through the same odo_app_step every other target calls, publish the result
-/// in odo_board_selftest, then idle.
-///
-/// There is no HAL backend for this board yet (hardware and qemu come in a later issue). When it
-/// lands, the synthetic loop below is replaced by the 40 ms loop of firmware/app (hal_wheel_read,
-/// hal_link_read -> odo_app_step -> hal_can_send) at the place marked "HAL loop".
+/// Cortex-M4 image entry: the boot self-test (odo_selftest.h, published in odo_board_selftest),
+/// then the board (odo_board_port.h: clocks, counters, CAN, tick timer, watchdog), then the 40 ms
+/// loop: wait for the tick, odo_board_tick (read, odo_app_step, publish), forever.
 #include <stdint.h>
 #include <string.h>
 
@@ -12,11 +8,13 @@
 #include "odo_board.h"
 
 volatile odo_board_selftest_t odo_board_selftest;
+volatile odo_board_status_t odo_board_status;
 
 // The whole application state is static: no heap, and the stack holds only call frames.
 static odo_app_t s_app;
 static odo_tick_input_t s_in;
 static odo_tick_output_t s_out;
+static hal_ctx_t s_hal;
 
 int main(void)
 {
@@ -24,8 +22,17 @@ int main(void)
     odo_selftest_run(&s_app, &s_in, &s_out, odo_param_block, sizeof odo_param_block, &r);
     odo_board_selftest = r;
 
-    // HAL loop: the 40 ms firmware/app loop over the cortexm HAL backend goes here.
+    odo_board_init(&s_hal, &odo_board_config);
+    (void)odo_app_init(&s_app, odo_param_block, sizeof odo_param_block);
     for (;;) {
-        __asm__ volatile("wfi");
+        if (!odo_board_wait_tick(&s_hal)) {
+            // No tick timer: nothing can run on time. Stop here; the watchdog (if it started)
+            // resets the part.
+            for (;;) {
+                __asm__ volatile("wfi");
+            }
+        }
+        odo_board_tick(&s_hal, &s_app, &s_in, &s_out);
+        odo_board_status = s_hal.status;
     }
 }

@@ -10,6 +10,7 @@
 #include <stdint.h>
 
 #include "odo/odo_params.h"
+#include "odo_board_port.h"
 #include "odo_selftest.h"
 
 #ifdef __cplusplus
@@ -22,6 +23,12 @@ extern "C" {
 /// replaces those 128 bytes in the .bin/.hex or on the part. Defined in its own translation unit
 /// so the compiler can never fold its contents into main(): the firmware reads what is in flash.
 extern const uint8_t odo_param_block[ODO_PARAMS_SIZE];
+
+/// The board's peripherals and pins (odo_board_config.c).
+extern const odo_board_config_t odo_board_config;
+
+/// What start-up found and the loop's counters (odo_board_port.h), refreshed every tick.
+extern volatile odo_board_status_t odo_board_status;
 
 /// Result of the boot self-test (odo_selftest.h), kept in RAM for a debugger and for
 /// tests/target, which reads it under qemu and compares it with the host's.
