@@ -27,7 +27,7 @@ bool odo_tick_timer_elapsed(odo_stm32_tim_t *tim)
     if ((odo_reg_read(&tim->SR) & ODO_TIM_SR_UIF) == 0U) {
         return false;
     }
-    odo_reg_write(&tim->SR, ~ODO_TIM_SR_UIF); /* rc_w0: writing 0 clears, 1 leaves the others */
+    odo_reg_write(&tim->SR, (uint32_t)~ODO_TIM_SR_UIF); /* rc_w0: writing 0 clears, 1 leaves the others */
     return true;
 }
 
