@@ -23,6 +23,7 @@ int main(void)
     odo_board_selftest = r;
 
     odo_board_init(&s_hal, &odo_board_config);
+    odo_board_status = s_hal.status; // what came up, before the first tick (tests/target reads it)
     (void)odo_app_init(&s_app, odo_param_block, sizeof odo_param_block);
     for (;;) {
         if (!odo_board_wait_tick(&s_hal)) {

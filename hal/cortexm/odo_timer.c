@@ -10,7 +10,10 @@ bool odo_tick_timer_init(odo_stm32_tim_t *tim, uint32_t tim_hz, uint32_t period_
         return false;
     }
     odo_reg_write(&tim->CR1, 0U);
-    odo_reg_write(&tim->DIER, 0U); /* polled: no interrupt */
+    /* Polled: the NVIC line stays disabled, so UIE takes no interrupt. It is set all the same
+     * because QEMU's STM32F405 timer model (stm32f2xx_timer) raises UIF only with UIE; on the
+     * part UIF is set either way (RM0090 18.4.5). */
+    odo_reg_write(&tim->DIER, ODO_TIM_DIER_UIE);
     odo_reg_write(&tim->PSC, mhz - 1U);
     odo_reg_write(&tim->ARR, period_us - 1U);
     odo_reg_write(&tim->CNT, 0U);

@@ -3,8 +3,8 @@
 /// TIM7)"; the registers used here sit at the same offsets in both).
 ///
 /// Tick: the timer counts microseconds (PSC = f_tim / 1 MHz - 1) up to ARR = period - 1 and sets
-/// UIF at each wrap; the main loop polls it (no interrupt), so a late loop sees at most one flag
-/// per missed period and counts the overrun.
+/// UIF at each wrap; the main loop polls it (the NVIC line stays disabled), so a late loop sees at
+/// most one flag per missed period and counts the overrun.
 ///
 /// Encoder (18.3.12 "Encoder interface mode"): TI1 and TI2 as inputs with a digital filter, SMS =
 /// 011 (count on both edges of both inputs: 4 counts per line, the HCTL-1100's 4x decoding), ARR

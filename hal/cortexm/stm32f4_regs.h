@@ -125,6 +125,7 @@ typedef struct {
 
 #define ODO_TIM_CR1_CEN  (1UL << 0)
 #define ODO_TIM_CR1_URS  (1UL << 2)
+#define ODO_TIM_DIER_UIE (1UL << 0)
 #define ODO_TIM_SR_UIF   (1UL << 0)
 #define ODO_TIM_EGR_UG   (1UL << 0)
 #define ODO_TIM_SMCR_SMS_ENCODER3 3UL

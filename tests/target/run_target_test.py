@@ -4,6 +4,7 @@
   unit      a tests/unit program cross-built for the Cortex-M4 runs on qemu's mps2-an386 with
             semihosting; its exit code must be 0 and its stdout byte-identical to the host build's
             run of the same program.
+  run       a semihosting driver test (e.g. the tick timer on netduinoplus2's TIM2): exit 0.
   selftest  the real image (build/cm4/bin/odo_image.elf) boots on qemu's netduinoplus2 (an
             STM32F405); the self-test result it leaves in RAM (odo_board_selftest, read over QMP)
             must equal the host's run of the same self-test on the same parameter block. With
@@ -34,6 +35,11 @@ SELFTEST_FMT = "<IIIIqqII"  # odo_board_selftest_t (hal/cortexm/odo_selftest.h),
 SELFTEST_KEYS = (
     "params_status steps faults_or frames x_mm_q32 y_mm_q32 heading_bam done".split()
 )
+# odo_board_status_t (hal/cortexm/odo_board_port.h): odo_clock_t (source, sysclk, hclk, pclk1,
+# pclk2, tim_apb1), can status, tick_ok, watchdog_ok, tick_overruns, tx_refused; 36 bytes, since
+# arm-none-eabi-gcc makes enums as small as their values (-fshort-enums is the AAPCS default there).
+BOARD_FMT = "<B3x5IBBBxII"
+CLOCK_HSI, BXCAN_ERR_INIT_MODE = 2, 3  # odo_clock_source_t, odo_bxcan_status_t
 FAULT_PARAMS_DEFAULTED = 1 << 0  # firmware/include/odo/odo_status.h
 PARAMS_ERR_MAGIC, PARAMS_ERR_CRC = 2, 5  # odo_params_status_t (odo/odo_params.h)
 
@@ -77,6 +83,19 @@ def run_unit(args: argparse.Namespace) -> int:
     if errors:
         return fail("; ".join(errors))
     print(f"target output is byte-identical to the host's ({len(tgt.stdout)} bytes)")
+    return 0
+
+
+def run_plain(args: argparse.Namespace) -> int:
+    cmd = [
+        qemu(), "-M", args.machine, "-display", "none", "-monitor", "none",
+        "-serial", "none", "-semihosting-config", "enable=on,target=native",
+        "-kernel", str(args.elf),
+    ]
+    tgt = subprocess.run(cmd, capture_output=True, timeout=args.timeout)
+    sys.stdout.write(tgt.stdout.decode(errors="replace"))
+    if tgt.returncode != 0:
+        return fail(f"{args.elf.name} on {args.machine} exited {tgt.returncode}")
     return 0
 
 
@@ -204,6 +223,17 @@ def run_selftest(args: argparse.Namespace) -> int:
                     return fail(f"the image did not finish its self-test in {args.timeout} s "
                                 f"(odo_board_selftest = {got})")
                 time.sleep(0.1)
+            board = None
+            if args.params == "none":
+                baddr, bsize = nm_symbols(image)["odo_board_status"]
+                if bsize != struct.calcsize(BOARD_FMT):
+                    return fail(f"odo_board_status is {bsize} bytes, the reader expects "
+                                f"{struct.calcsize(BOARD_FMT)}: update BOARD_FMT")
+                while True:
+                    board = struct.unpack(BOARD_FMT, qmp.read_mem(baddr, bsize))
+                    if board[7] == 1 or time.monotonic() > deadline:  # tick_ok: start-up done
+                        break
+                    time.sleep(0.1)
         finally:
             proc.kill()
             proc.communicate()
@@ -217,6 +247,14 @@ def run_selftest(args: argparse.Namespace) -> int:
         if args.params == "none":
             if got["params_status"] != 0 or got["faults_or"] & FAULT_PARAMS_DEFAULTED:
                 errors.append("the image's own parameter block was not accepted")
+            # qemu's STM32F405 has no RCC and no bxCAN: start-up must still finish, on the HSI,
+            # with CAN reported down, and the tick timer running.
+            print(f"board start-up under qemu: clock source {board[0]} at {board[1]} Hz, "
+                  f"CAN status {board[6]}, tick timer {'on' if board[7] else 'off'}")
+            if board[7] != 1:
+                errors.append("board start-up did not finish (odo_board_status.tick_ok)")
+            elif (board[0], board[1], board[6]) != (CLOCK_HSI, 16000000, BXCAN_ERR_INIT_MODE):
+                errors.append("board start-up did not report qemu's missing RCC and bxCAN")
         else:
             want_status = PARAMS_ERR_MAGIC if args.params == "erased" else PARAMS_ERR_CRC
             if got["params_status"] != want_status:
@@ -243,7 +281,13 @@ def main() -> int:
     s.add_argument("--host", type=Path, required=True, help="selftest_host program")
     s.add_argument("--params", choices=("none", "erased", "corrupt"), default="none")
     s.add_argument("--timeout", type=float, default=20.0)
+    r = sub.add_parser("run", help="a semihosting program; exit code 0 required")
+    r.add_argument("--elf", type=Path, required=True)
+    r.add_argument("--machine", default="netduinoplus2")
+    r.add_argument("--timeout", type=float, default=60.0)
     args = ap.parse_args()
+    if args.mode == "run":
+        return run_plain(args)
     for p in (args.elf, args.host):
         if not p.is_file():
             return fail(f"{p} does not exist (build the host and cm4 presets)")

@@ -81,7 +81,7 @@ END_TEST
 
 /* ---- timers ------------------------------------------------------------------------------ */
 
-/// 40 ms from an 84 MHz timer clock: 1 MHz count (PSC 83), ARR 39999, counting, no interrupt; UIF
+/// 40 ms from an 84 MHz timer clock: 1 MHz count (PSC 83), ARR 39999, counting; UIF
 /// is reported once and cleared without touching the other status bits (rc_w0).
 START_TEST(tick_timer_counts_microseconds_to_40_ms)
 {
@@ -90,7 +90,7 @@ START_TEST(tick_timer_counts_microseconds_to_40_ms)
     ck_assert_uint_eq(t->PSC, 83U);
     ck_assert_uint_eq(t->ARR, 39999U);
     ck_assert_uint_eq(t->CR1 & ODO_TIM_CR1_CEN, ODO_TIM_CR1_CEN);
-    ck_assert_uint_eq(t->DIER, 0U);
+    ck_assert_uint_eq(t->DIER, ODO_TIM_DIER_UIE); /* for qemu's model; the NVIC line stays off */
     ck_assert(!odo_tick_timer_elapsed(t));
     t->SR = ODO_TIM_SR_UIF | (1UL << 1); /* update and CC1IF */
     ck_assert(odo_tick_timer_elapsed(t));
