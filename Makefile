@@ -4,7 +4,7 @@ SHELL := /bin/bash
 .DEFAULT_GOAL := help
 JOBS ?= $(shell nproc)
 
-.PHONY: help deps build release cm4 test demo bench bench-target flash flash-params clean
+.PHONY: help deps build release cm4 test demo bench bench-target flash flash-params flash-all clean
 
 help: ## list targets
 	@grep -E '^[a-z0-9-]+:.*## ' $(MAKEFILE_LIST) | awk -F':.*## ' '{printf "  make %-12s %s\n", $$1, $$2}'
@@ -35,6 +35,15 @@ bench: release ## print benchmark figures as JSON (-O2 build: build/release/bin/
 
 bench-target: release cm4 ## Cortex-M4 figures as JSON: instructions per tick (emulated), flash, RAM, stack
 	@.venv/bin/odo-bench-target --build-dir build/release --cm4-dir build/cm4
+
+flash: cm4 ## program the image with openocd, never its parameter sector (odo-flash code)
+	@.venv/bin/odo-flash code --image build/cm4/bin/odo_image.elf
+
+flash-params: cm4 ## program only the parameter block: make flash-params PARAMS=fw.elf|fw.hex|block.bin
+	@.venv/bin/odo-flash params --image build/cm4/bin/odo_image.elf --params "$(PARAMS)"
+
+flash-all: cm4 ## program image and its default parameter block (erases a calibrated block)
+	@.venv/bin/odo-flash all --image build/cm4/bin/odo_image.elf
 
 clean: ## remove build output (keeps .venv)
 	rm -rf build
