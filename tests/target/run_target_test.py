@@ -30,7 +30,6 @@ import time
 from pathlib import Path
 
 QEMU = "qemu-system-arm"
-SELFTEST_DONE = 0x600DF00D
 SELFTEST_FMT = "<IIIIqqII"  # odo_board_selftest_t (hal/cortexm/odo_selftest.h), 40 bytes
 SELFTEST_KEYS = (
     "params_status steps faults_or frames x_mm_q32 y_mm_q32 heading_bam done".split()
@@ -39,9 +38,6 @@ SELFTEST_KEYS = (
 # pclk2, tim_apb1), can status, tick_ok, watchdog_ok, tick_overruns, tx_refused; 36 bytes, since
 # arm-none-eabi-gcc makes enums as small as their values (-fshort-enums is the AAPCS default there).
 BOARD_FMT = "<B3x5IBBBxII"
-CLOCK_HSI, BXCAN_ERR_INIT_MODE = 2, 3  # odo_clock_source_t, odo_bxcan_status_t
-FAULT_PARAMS_DEFAULTED = 1 << 0  # firmware/include/odo/odo_status.h
-PARAMS_ERR_MAGIC, PARAMS_ERR_CRC = 2, 5  # odo_params_status_t (odo/odo_params.h)
 
 
 def fail(msg: str) -> int:
@@ -199,6 +195,9 @@ def run_selftest(args: argparse.Namespace) -> int:
         if host.returncode != 0:
             return fail(f"host self-test exited {host.returncode}: {host.stderr}")
         want = dict(kv.split("=") for kv in host.stdout.split())
+        codes_out = subprocess.run([str(args.host), "--codes"], capture_output=True, text=True,
+                                   check=True).stdout
+        codes = {k: int(v) for k, v in (kv.split("=") for kv in codes_out.split())}
 
         addr, size = nm_symbols(image)["odo_board_selftest"]
         if size != struct.calcsize(SELFTEST_FMT):
@@ -217,7 +216,7 @@ def run_selftest(args: argparse.Namespace) -> int:
             while True:
                 vals = struct.unpack(SELFTEST_FMT, qmp.read_mem(addr, size))
                 got = dict(zip(SELFTEST_KEYS, vals, strict=True))
-                if got["done"] == SELFTEST_DONE:
+                if got["done"] == codes["selftest_done"]:
                     break
                 if time.monotonic() > deadline:
                     return fail(f"the image did not finish its self-test in {args.timeout} s "
@@ -245,7 +244,8 @@ def run_selftest(args: argparse.Namespace) -> int:
         errors = [f"{k}: target {got_s[k]}, host {want.get(k)}" for k in SELFTEST_KEYS
                   if got_s[k] != want.get(k)]
         if args.params == "none":
-            if got["params_status"] != 0 or got["faults_or"] & FAULT_PARAMS_DEFAULTED:
+            if (got["params_status"] != codes["params_ok"]
+                    or got["faults_or"] & codes["fault_params_defaulted"]):
                 errors.append("the image's own parameter block was not accepted")
             # qemu's STM32F405 has no RCC and no bxCAN: start-up must still finish, on the HSI,
             # with CAN reported down, and the tick timer running.
@@ -253,15 +253,16 @@ def run_selftest(args: argparse.Namespace) -> int:
                   f"CAN status {board[6]}, tick timer {'on' if board[7] else 'off'}")
             if board[7] != 1:
                 errors.append("board start-up did not finish (odo_board_status.tick_ok)")
-            elif (board[0], board[1], board[6]) != (CLOCK_HSI, 16000000, BXCAN_ERR_INIT_MODE):
+            elif (board[0], board[1], board[6]) != (
+                    codes["clock_hsi"], codes["clock_hsi_hz"], codes["bxcan_err_init_mode"]):
                 errors.append("board start-up did not report qemu's missing RCC and bxCAN")
         else:
-            want_status = PARAMS_ERR_MAGIC if args.params == "erased" else PARAMS_ERR_CRC
+            want_status = codes["params_err_magic" if args.params == "erased" else "params_err_crc"]
             if got["params_status"] != want_status:
                 errors.append(f"params_status {got['params_status']}, want {want_status}")
-            if not got["faults_or"] & FAULT_PARAMS_DEFAULTED:
+            if not got["faults_or"] & codes["fault_params_defaulted"]:
                 errors.append("ODO_FAULT_PARAMS_DEFAULTED was not raised")
-            if got["steps"] != 8:
+            if got["steps"] == 0:
                 errors.append("the image did not run its self-test on defaults")
         if errors:
             return fail("; ".join(errors))

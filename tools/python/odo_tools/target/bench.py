@@ -36,8 +36,6 @@ import unicorn
 from odo_tools.target.emu import Firmware
 from odo_tools.target.stack import flash_by_origin, section_sizes, worst_stack
 
-IN_SIZE = 8 + 4 + 2 * 12 + 16  # tools/bench_target/bench_codec.h ODO_BENCH_IN_SIZE
-OUT_SIZE = 2 * 24 + 4 * 4 + 1 + 2 * 16 + 4 + 1 + 6 * 14  # ODO_BENCH_OUT_SIZE
 MODES = ("off", "paper", "estimator")
 FLASH_BASE, FLASH_END = 0x08000000, 0x08100000
 RAM_BASE = 0x20000000
@@ -63,18 +61,25 @@ def run(cmd: list[str]) -> None:
         raise SystemExit(f"odo-bench-target: `{' '.join(cmd)}` failed:\n{proc.stdout}{proc.stderr}")
 
 
-def read_ticks(path: Path) -> tuple[bytes, list[tuple[bytes, bytes]]]:
+def record_sizes(elf: Path) -> tuple[int, int]:
+    """ODO_BENCH_IN_SIZE and ODO_BENCH_OUT_SIZE (bench_codec.h), as the harness's buffers."""
+    fw = Firmware(elf, [])
+    return fw.symbols["odo_bench_in"][1], fw.symbols["odo_bench_out"][1]
+
+
+def read_ticks(path: Path, sizes: tuple[int, int]) -> tuple[bytes, list[tuple[bytes, bytes]]]:
+    in_size, out_size = sizes
     data = path.read_bytes()
     if data[:4] != b"ODOT":
         raise SystemExit(f"odo-bench-target: {path} is not a ticks file")
     _, n, blen = struct.unpack_from("<III", data, 4)
     block, off = data[16 : 16 + blen], 16 + blen
-    if len(data) != off + n * (IN_SIZE + OUT_SIZE):
+    if len(data) != off + n * (in_size + out_size):
         raise SystemExit(f"odo-bench-target: {path}: size does not match {n} ticks")
     ticks = []
     for _ in range(n):
-        ticks.append((data[off : off + IN_SIZE], data[off + IN_SIZE : off + IN_SIZE + OUT_SIZE]))
-        off += IN_SIZE + OUT_SIZE
+        ticks.append((data[off : off + in_size], data[off + in_size : off + in_size + out_size]))
+        off += in_size + out_size
     return block, ticks
 
 
@@ -135,7 +140,7 @@ def memory_figures(args: argparse.Namespace) -> dict:
 
 def qemu_cross_check(args: argparse.Namespace, ticks_file: Path, n: int, work: Path) -> int:
     elf = args.cm4_dir / "bin/odo_bench_cm4.elf"
-    block, ticks = read_ticks(ticks_file)
+    block, ticks = read_ticks(ticks_file, record_sizes(elf))
     ticks = ticks[:n]
     # The harness reads odo_ticks.bin from qemu's working directory (semihosting).
     hdr = b"ODOT" + struct.pack("<III", 1, len(ticks), len(block))
@@ -209,7 +214,7 @@ def main(argv: list[str] | None = None) -> int:
         bad = 0
         for mode in MODES:
             t0 = time.monotonic()
-            block, ticks = read_ticks(files[mode])
+            block, ticks = read_ticks(files[mode], record_sizes(elf))
             init, counts, differ = emulate(elf, block, ticks, args.ticks)
             log(f"IPEC {mode}: {len(counts)} ticks in {time.monotonic() - t0:.1f} s, "
                 f"{len(differ)} outputs differ from the host's")
