@@ -79,13 +79,15 @@ def test_flash_refuses_what_is_not_a_good_block(tmp_path: Path) -> None:
     assert r.returncode == 0 and "usage" in r.stdout
     syms = flash.elf_symbols(image)
     cap = syms["__odo_params_sector_end"] - syms["__odo_params_start"]
-    block = (CM4 / "odo_image.bin").read_bytes()[syms["__odo_params_start"] - 0x08000000:][:128]
+    raw = (CM4 / "odo_image.bin").read_bytes()
+    at = syms["__odo_params_start"] - syms["__odo_flash_start"]
+    block = raw[at : at + int.from_bytes(raw[at + 6 : at + 8], "little")]  # its length field
     assert flash.check_block(block, cap, "x") == block
     long_len = bytearray(block)
     long_len[6:8] = (cap + 1).to_bytes(2, "little")
     for blob, why in ((b"nope" + block[4:], "no parameter block"),
                       (bytes(long_len), "does not fit"),
-                      (block[:100], "does not fit")):
+                      (block[:-10], "does not fit")):
         with pytest.raises(flash.FlashError, match=why):
             flash.check_block(blob, cap, "x")
     bad_hex = tmp_path / "bad.hex"
