@@ -4,7 +4,7 @@ SHELL := /bin/bash
 .DEFAULT_GOAL := help
 JOBS ?= $(shell nproc)
 
-.PHONY: help deps build release cm4 test demo bench bench-target flash flash-params flash-all clean
+.PHONY: help deps build release cm4 test demo bench bench-target soak flash flash-params flash-all clean
 
 help: ## list targets
 	@grep -E '^[a-z0-9-]+:.*## ' $(MAKEFILE_LIST) | awk -F':.*## ' '{printf "  make %-12s %s\n", $$1, $$2}'
@@ -44,6 +44,9 @@ flash-params: cm4 ## program only the parameter block: make flash-params PARAMS=
 
 flash-all: cm4 ## program image and its default parameter block (erases a calibrated block)
 	@.venv/bin/odo-flash all --image build/cm4/bin/odo_image.elf
+
+soak: release ## frame loss at speed and the 24 h fault soak, JSON (build/release/bin/odo-soak --json)
+	@build/release/bin/odo-soak --json
 
 clean: ## remove build output (keeps .venv)
 	rm -rf build

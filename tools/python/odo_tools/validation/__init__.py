@@ -1,0 +1,1 @@
+"""Checks of the project's tools against worlds and data they did not generate."""
