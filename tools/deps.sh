@@ -10,6 +10,7 @@ APT_PACKAGES=(
   python3 python3-venv                                             # host tools, pytest
   valgrind                                                         # odo-bench instruction counts
   libjansson-dev                                                   # host_sim robot/scenario JSON
+  libgsl-dev                                                       # odo-calib fit: nonlinear least squares
   qemu-system-x86 busybox-static cpio can-utils                     # vcan test: Debian kernel under qemu
   qemu-system-arm                                                  # target tests: Cortex-M4 boards under qemu
   openocd                                                          # make flash; its config check in ctest
