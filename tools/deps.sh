@@ -14,6 +14,8 @@ APT_PACKAGES=(
   qemu-system-x86 busybox-static cpio can-utils                     # vcan test: Debian kernel under qemu
   clang libclang-rt-14-dev                                         # fuzz/: libFuzzer harnesses
   cppcheck clang-tidy clang-format gcovr                           # static analysis, format check, coverage
+  qemu-system-arm                                                  # target tests: Cortex-M4 boards under qemu
+  openocd                                                          # make flash; its config check in ctest
 )
 
 missing=()
