@@ -30,15 +30,15 @@ odo_clock_t odo_clock_init(odo_stm32_rcc_t *rcc, odo_stm32_flash_t *flash, uint3
     odo_reg_modify(&rcc->CR, ODO_RCC_CR_PLLON, 0U);
 
     int use_hse = 0;
-    const uint32_t hse_mhz = hse_hz / 1000000UL;
-    if (hse_mhz >= 4U && hse_mhz <= 26U && hse_mhz * 1000000UL == hse_hz) {
+    const uint32_t hse_mhz = hse_hz / 1000000U;
+    if (hse_mhz >= 4U && hse_mhz <= 26U && hse_mhz * 1000000U == hse_hz) {
         odo_reg_modify(&rcc->CR, ODO_RCC_CR_HSEBYP, ODO_RCC_CR_HSEON);
         use_hse = odo_reg_wait(&rcc->CR, ODO_RCC_CR_HSERDY, ODO_RCC_CR_HSERDY, polls);
         if (!use_hse) {
             odo_reg_modify(&rcc->CR, ODO_RCC_CR_HSEON, 0U); /* no crystal: stop trying */
         }
     }
-    const uint32_t pllm = use_hse ? hse_mhz : ODO_CLOCK_HSI_HZ / 1000000UL;
+    const uint32_t pllm = use_hse ? hse_mhz : ODO_CLOCK_HSI_HZ / 1000000U;
     odo_reg_write(&rcc->PLLCFGR, ODO_RCC_PLLCFGR(pllm, PLLN, PLLP, use_hse, PLLQ));
     odo_reg_modify(&rcc->CR, 0U, ODO_RCC_CR_PLLON);
     if (!odo_reg_wait(&rcc->CR, ODO_RCC_CR_PLLRDY, ODO_RCC_CR_PLLRDY, polls)) {

@@ -21,8 +21,8 @@
 extern "C" {
 #endif
 
-#define ODO_CLOCK_HSI_HZ    16000000UL
-#define ODO_CLOCK_TARGET_HZ 168000000UL
+#define ODO_CLOCK_HSI_HZ    16000000U
+#define ODO_CLOCK_TARGET_HZ 168000000U
 
 typedef enum {
     ODO_CLOCK_HSE_PLL = 0, ///< 168 MHz from the crystal (the normal case)

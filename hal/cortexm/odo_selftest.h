@@ -27,7 +27,7 @@ typedef struct {
     uint32_t done;          ///< ODO_BOARD_SELFTEST_DONE when the above are complete
 } odo_board_selftest_t;
 
-#define ODO_BOARD_SELFTEST_DONE 0x600DF00DUL
+#define ODO_BOARD_SELFTEST_DONE 0x600DF00DU
 
 /// Boot *app on block[0..len) (odo_app_init: defaults and a fault flag if the block is bad), run
 /// ODO_SELFTEST_TICKS synthetic ticks of truck A (straight, left and right turns, a stop, and a
