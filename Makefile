@@ -51,5 +51,14 @@ soak: release ## frame loss at speed and the 24 h fault soak, JSON (build/releas
 fuzz: deps ## long libFuzzer campaigns, 10^7 execs per harness (FUZZ_RUNS=N to change), JSON (fuzz/README.md)
 	@python3 fuzz/campaign.py --runs $(or $(FUZZ_RUNS),10000000)
 
+coverage: deps ## firmware/ line and branch coverage from the Unity tests (gcovr; build/coverage)
+	@cmake --preset coverage >/dev/null
+	@cmake --build --preset coverage -j $(JOBS) --target $(notdir $(basename $(wildcard tests/unit/test_*.c)))
+	@find build/coverage -name '*.gcda' -delete
+	@ctest --test-dir build/coverage -R '^unit[.]' -j $(JOBS) --output-on-failure >/dev/null
+	@gcovr --root . --filter 'firmware/' --exclude-unreachable-branches --print-summary \
+	  --txt build/coverage/coverage.txt build/coverage | tail -n 3
+	@echo "per file: build/coverage/coverage.txt"
+
 clean: ## remove build output (keeps .venv)
 	rm -rf build
