@@ -39,8 +39,9 @@ static void usage(FILE *f)
             "Writes DIR/run-<dir>-NN.log (sensor frames, candump -l), DIR/run-<dir>-NN.truth.csv,\n"
             "DIR/returns.csv and DIR/summary.json. An existing DIR is replaced only if it holds a\n"
             "previous odo-sim output.\n"
-            "--log-start: the logs' first timestamp, seconds since the epoch (default now, the wall\n"
-            "clock's whole second; 0 for reproducible logs). Truth CSV times count from it.\n"
+            "--log-start: the logs' first timestamp, whole seconds since the epoch (default\n"
+            "$SOURCE_DATE_EPOCH if set, else now; 0 for reproducible logs). Truth CSV times count\n"
+            "from it.\n"
             "--params P.json|P.bin: run the firmware with this parameter block's calibration (Ed, Eb,\n"
             "Es per truck, e.g. from odo-calib umbmark --out-params); the world keeps the robot's true\n"
             "geometry, and the block's nominal geometry must match the robot description's.\n");
@@ -206,8 +207,12 @@ int main(int argc, char **argv)
     int ipec = 0, quiet = 0, seed_given = 0, list_effects = 0, list_json = 0;
     uint64_t seed = 0;
     const char *params_path = NULL; /* --params: calibration for the firmware */
-    uint64_t log_start_us = 0U;     /* --log-start; the wall clock unless given */
-    (void)odo_log_start_parse("now", &log_start_us);
+    uint64_t log_start_us = 0U;     /* --log-start; else SOURCE_DATE_EPOCH, else the wall clock */
+    if (odo_log_start_default(&log_start_us) != 0) {
+        fprintf(stderr, "odo-sim: SOURCE_DATE_EPOCH must be whole seconds 0..%llu\n",
+                (unsigned long long)ODO_LOG_START_MAX_S);
+        return 2;
+    }
     for (int i = 1; i < argc; ++i) {
         const char *a = argv[i];
         const char *v = i + 1 < argc ? argv[i + 1] : NULL;

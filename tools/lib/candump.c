@@ -32,6 +32,12 @@ int odo_log_start_parse(const char *text, uint64_t *start_us)
     return 0;
 }
 
+int odo_log_start_default(uint64_t *start_us)
+{
+    const char *env = getenv("SOURCE_DATE_EPOCH");
+    return odo_log_start_parse(env != NULL && env[0] != '\0' ? env : "now", start_us);
+}
+
 int odo_candump_write(FILE *f, uint64_t t_us, const char *iface, const odo_can_frame_t *frame)
 {
     const int ext = (frame->flags & ODO_CAN_FLAG_EXT) != 0U;

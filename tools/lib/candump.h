@@ -19,6 +19,11 @@
 /// Returns 0 with *start_us set, or -1 (*start_us untouched) for anything else.
 int odo_log_start_parse(const char *text, uint64_t *start_us);
 
+/// The start a recording tool uses when not told: $SOURCE_DATE_EPOCH when it is set (the
+/// reproducible-builds convention; tests set it to 0), else "now". Returns 0, or -1 when
+/// SOURCE_DATE_EPOCH is set but not whole seconds 0..ODO_LOG_START_MAX_S.
+int odo_log_start_default(uint64_t *start_us);
+
 /// Write one frame as a candump -l line: 3-hex standard or 8-hex extended ID, data in upper-case
 /// hex, "R" for remote frames. Returns 0, or -1 if the stream reported an error.
 int odo_candump_write(FILE *f, uint64_t t_us, const char *iface, const odo_can_frame_t *frame);
