@@ -40,8 +40,8 @@ static void usage(FILE *f)
             "DIR/returns.csv and DIR/summary.json. An existing DIR is replaced only if it holds a\n"
             "previous odo-sim output.\n"
             "--log-start: the logs' first timestamp, whole seconds since the epoch (default\n"
-            "$SOURCE_DATE_EPOCH if set, else now; 0 for reproducible logs). Truth CSV times count\n"
-            "from it.\n"
+            "$SOURCE_DATE_EPOCH if set, else now; 0 for reproducible logs). The truth CSVs' t_s is\n"
+            "on the same clock.\n"
             "--params P.json|P.bin: run the firmware with this parameter block's calibration (Ed, Eb,\n"
             "Es per truck, e.g. from odo-calib umbmark --out-params); the world keeps the robot's true\n"
             "geometry, and the block's nominal geometry must match the robot description's.\n");
@@ -86,7 +86,9 @@ static void on_tick(void *user, const sim_tick_t *tk)
     run_files_t *rf = user;
     write_sensor_frames(rf, tk);
     const double deg = 180.0 / M_PI;
-    fprintf(rf->truth, "%.3f,%.4f,%.4f,%.6f,%.4f,%.4f,%.6f,%.6f,%.6f,%.4f,", tk->t_s, tk->truth[0].x_mm,
+    /* on the log's clock: a whole-second start (--log-start) plus the run's time */
+    fprintf(rf->truth, "%.3f,%.4f,%.4f,%.6f,%.4f,%.4f,%.6f,%.6f,%.6f,%.4f,",
+            (double)(rf->start_us / 1000000U) + tk->t_s, tk->truth[0].x_mm,
             tk->truth[0].y_mm, tk->truth[0].theta_rad * deg, tk->truth[1].x_mm, tk->truth[1].y_mm,
             tk->truth[1].theta_rad * deg, tk->link.alpha_rad * deg, tk->link.beta_rad * deg,
             tk->link.length_mm);

@@ -7,6 +7,7 @@ from 0 gets a new ASC header before every frame of its first second (and one mor
 wall clock it gets one.
 """
 
+import json
 import os
 import shutil
 import subprocess
@@ -94,10 +95,13 @@ def test_fixed_epoch_is_reproducible_and_shifts_exactly(runs):
     assert [t - EPOCH * 1_000_000 for t in stamps_us(d / "epoch/run-cw-01.log")] == stamps_us(z)
     # SOURCE_DATE_EPOCH (what ctest sets) gives the same bytes as the flag
     assert (d / "sde/run-cw-01.log").read_bytes() == (d / "epoch/run-cw-01.log").read_bytes()
-    # the truth CSV counts from the start either way
-    assert (d / "epoch/run-cw-01.truth.csv").read_bytes() == z.with_suffix("").with_suffix(
-        ".truth.csv"
-    ).read_bytes()
+    # the truth CSV is on the log's clock
+    tz = np.loadtxt(
+        z.with_suffix("").with_suffix(".truth.csv"), delimiter=",", skiprows=1, usecols=(0, 1, 2)
+    )
+    te = np.loadtxt(d / "epoch/run-cw-01.truth.csv", delimiter=",", skiprows=1, usecols=(0, 1, 2))
+    np.testing.assert_allclose(te[:, 0] - EPOCH, tz[:, 0], rtol=0, atol=1e-6)
+    np.testing.assert_array_equal(te[:, 1:], tz[:, 1:])
 
 
 @pytest.mark.parametrize("bad", ["-1", "1.5", "", "abc", " 5", "+5", "8589934593", "1e9"])
@@ -113,17 +117,57 @@ def test_bad_source_date_epoch_is_refused(tmp_path):
     assert not (tmp_path / "out").exists()
 
 
-def test_gap_reader_finds_t0_in_a_wall_clock_log(runs):
-    """odo-gap's reader gives the same run times for the same run started at 0 or at an epoch."""
-    from odo_tools.gap.io import read_log, read_robot
+def test_gap_pairs_a_wall_clock_log_with_its_truth(runs):
+    """odo-gap's readers take the log and the truth on one clock: the same run started at 0 or at
+    an epoch gives the same samples, shifted by the epoch, and the same truth at each tick."""
+    from odo_tools.gap.io import read_log, read_robot, read_truth
 
     d, _, _ = runs
     robot = read_robot(ROBOT)
     a = read_log(d / "zero/run-cw-01.log", robot)
     b = read_log(d / "epoch/run-cw-01.log", robot)
     assert a.t_s[0] == 0.0
-    np.testing.assert_allclose(b.t_s, a.t_s, rtol=0, atol=1e-6)
+    np.testing.assert_allclose(b.t_s - EPOCH, a.t_s, rtol=0, atol=1e-6)
     np.testing.assert_array_equal(b.counts, a.counts)
+    ta = read_truth(d / "zero/run-cw-01.truth.csv", robot)
+    tb = read_truth(d / "epoch/run-cw-01.truth.csv", robot)
+    xa = np.interp(a.t_s, ta.t_s, ta.pose[:, 0, 0])
+    xb = np.interp(b.t_s, tb.t_s, tb.pose[:, 0, 0])
+    np.testing.assert_allclose(xb, xa, rtol=0, atol=1e-3)
+
+
+def test_calib_fit_pairs_a_wall_clock_log_with_its_truth(runs):
+    """odo-calib fit puts its ticks on the log's clock: the same fit from either start, and the
+    scenario's hidden Ed found from the wall-clock run."""
+    d, _, _ = runs
+    ed_true = json.loads((SRC / "host_sim/scenarios/effect-ed.json").read_text())["effects"]["ed"][
+        "value"
+    ]
+    fits = {}
+    for name in ("zero", "epoch"):
+        r = subprocess.run(
+            [
+                str(BUILD / "bin/odo-calib"),
+                "fit",
+                "--runs",
+                str(d / name),
+                "--robot",
+                str(ROBOT),
+                "--free",
+                "ed,eb",
+                "--json",
+            ],
+            capture_output=True,
+            text=True,
+            timeout=300,
+        )
+        assert r.returncode == 0, r.stderr
+        fits[name] = json.loads(r.stdout)
+    # the same up to the 1e-9 that absolute times in doubles cost (2^-22 s at 1.7e9 s)
+    for k, v in fits["zero"]["params"].items():
+        assert fits["epoch"]["params"][k] == pytest.approx(v, abs=1e-8), k
+    assert fits["epoch"]["rms_mm"] == pytest.approx(fits["zero"]["rms_mm"], abs=1e-3)
+    assert abs(fits["epoch"]["params"]["ed"] - ed_true) < 1e-5
 
 
 def test_replay_of_a_wall_clock_log_counts_from_its_first_tick(runs, tmp_path):

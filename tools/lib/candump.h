@@ -14,8 +14,8 @@
 /// A log's start time, as a CLI takes it (`--log-start`): "now", the wall clock rounded down to
 /// a whole second, or a whole number of seconds since the Unix epoch, 0..ODO_LOG_START_MAX_S
 /// ("0" for reproducible test vectors). A writer stamps each frame start + the run's own time, so
-/// the sub-second digits of a log are the run's clock and a reader finds the run's t = 0 as the
-/// whole second its first frame falls in (the truth CSV beside a log counts from there).
+/// the sub-second digits of a log are the run's clock; the truth CSV beside a log is on the same
+/// clock, and readers pair the two by time, never by assuming a log starts at 0.
 /// Returns 0 with *start_us set, or -1 (*start_us untouched) for anything else.
 int odo_log_start_parse(const char *text, uint64_t *start_us);
 

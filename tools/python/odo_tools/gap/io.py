@@ -207,11 +207,7 @@ def read_log(path: str | Path, robot: Robot) -> SensorLog:
         raise GapInputError(path, f"not a candump -l line: {bad!r} ({e})", line) from None
     if not ts_l:
         raise GapInputError(path, "no classic CAN frames (only CAN FD, error or remote frames)")
-    # The run's t = 0 is the whole second the first frame falls in: a writer stamps start + run
-    # time with a whole-second start (wall clock or 0; tools/lib/candump.h odo_log_start_parse),
-    # and the truth CSV counts from that start.
     ts = np.asarray(ts_l)
-    ts = ts - np.floor(ts[0])
     ids = np.asarray(ids_l, dtype=np.int64)
     pay = np.asarray(pay_l, dtype=np.uint64)
     bad = np.nonzero(np.diff(ts) < 0)[0]
