@@ -45,16 +45,28 @@ endforeach()
 add_custom_target(odo_installable)
 add_dependencies(odo_installable ${ODO_INSTALL_CLIS} odosim_shared)
 
-# Man pages from each CLI's --help, so they cannot drift from it.
+# Man pages from each CLI's --help, so they cannot drift from it; NAME lines from this table.
+set(_odo_name_odo-sim "simulate the papers' experiments with the firmware in the loop")
+set(_odo_name_odo-calib "UMBmark calibration and parameter blocks in firmware images")
+set(_odo_name_odo-replay "replay CAN logs or a live bus through the firmware")
+set(_odo_name_odo-params "write, show and check parameter blocks")
+set(_odo_name_odo-ipec "IPEC figures, traces and self-calibration")
+set(_odo_name_odo-canvec "the firmware's CAN codec on stdin and stdout")
+set(_odo_name_odo-soak "frame loss at speed and the 24 h fault soak")
+set(_odo_name_odo-bench "the firmware's accuracy and speed figures")
+set(_odo_name_odo-demo "drive a UMBmark square through the firmware step")
 find_program(ODO_HELP2MAN help2man)
 if(ODO_HELP2MAN)
   set(_odo_mans "")
   foreach(cli IN LISTS ODO_INSTALL_CLIS)
+    if(NOT DEFINED _odo_name_${cli})
+      message(FATAL_ERROR "cmake/OdoInstall.cmake: no man page NAME line for ${cli}")
+    endif()
     set(_man "${CMAKE_BINARY_DIR}/man/${cli}.1")
     add_custom_command(OUTPUT "${_man}"
       COMMAND "${CMAKE_COMMAND}" -E make_directory "${CMAKE_BINARY_DIR}/man"
       COMMAND "${ODO_HELP2MAN}" --no-info --no-discard-stderr
-              "--version-string=${PROJECT_VERSION}" "--name=${cli} (odometry firmware tools)"
+              "--version-string=${PROJECT_VERSION}" "--name=${_odo_name_${cli}}"
               --output "${_man}" "$<TARGET_FILE:${cli}>"
       DEPENDS ${cli}
       COMMENT "man page ${cli}.1"
