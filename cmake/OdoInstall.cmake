@@ -9,6 +9,7 @@
 #     can/odometry.dbc               the single source of truth for every frame
 #     host_sim/robots/*.json         example robot descriptions (and OptiOdom's, from gap/robots)
 #     host_sim/scenarios/*.json      example simulator scenarios
+#     hal/cortexm/openocd/*.cfg      odo-flash's openocd configuration
 #   PREFIX/share/doc/odometry/       the READMEs
 #   PREFIX/share/man/man1/           a man page per CLI, made from its --help (help2man)
 #
@@ -30,6 +31,8 @@ file(GLOB _odo_robots CONFIGURE_DEPENDS "${CMAKE_SOURCE_DIR}/host_sim/robots/*.j
 install(FILES ${_odo_robots} DESTINATION "${ODO_SHARE}/host_sim/robots")
 install(DIRECTORY host_sim/scenarios/ DESTINATION "${ODO_SHARE}/host_sim/scenarios"
         FILES_MATCHING PATTERN "*.json")
+install(DIRECTORY hal/cortexm/openocd/ DESTINATION "${ODO_SHARE}/hal/cortexm/openocd"
+        FILES_MATCHING PATTERN "*.cfg")
 
 # READMEs under their folder's name: README.md, can.md, host_sim.md, ...
 install(FILES README.md DESTINATION "${CMAKE_INSTALL_DOCDIR}")

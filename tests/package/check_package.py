@@ -35,7 +35,15 @@ CLIS = [
     "odo-bench",
     "odo-demo",
 ]
-PY_TOOLS = ["odo-gap", "odo-import", "odo-plot-umbmark", "odo-plot-demo", "odo-plot-realdata"]
+PY_TOOLS = [
+    "odo-gap",
+    "odo-import",
+    "odo-plot-umbmark",
+    "odo-plot-demo",
+    "odo-plot-realdata",
+    "odo-flash",
+    "odo-bench-target",
+]
 T0 = time.monotonic()
 
 
@@ -117,6 +125,7 @@ def unpack(deb: Path, root: Path) -> Path:
         "share/odometry/host_sim/robots/labmate.json",
         "share/odometry/host_sim/robots/optiodom.json",
         "share/odometry/host_sim/scenarios/set-sim.json",
+        "share/odometry/hal/cortexm/openocd/odo_stm32f4.cfg",
         "share/doc/odometry/README.md",
     ]:
         check((usr / f).is_file(), f"usr/{f}")
@@ -143,6 +152,7 @@ def install_wheel(a: argparse.Namespace, work: Path) -> Path:
         "odo_tools/data/can/odometry.dbc",
         "odo_tools/data/host_sim/robots/labmate.json",
         "odo_tools/gap/robots/optiodom.json",
+        "odo_tools/data/hal/cortexm/openocd/odo_stm32f4.cfg",
     ]:
         check(f in names, f"the wheel carries {f}")
     step("fresh venv + pip install the wheel")

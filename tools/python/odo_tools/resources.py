@@ -5,8 +5,9 @@ Two layouts, one rule each:
 - A checkout (the package imported from tools/python, editable or by path): the repository
   itself, found by walking up from this file to can/odometry.dbc; libodosim.so in
   build/<preset>/lib (the gap modules' own search, tools/python/odo_tools/gap/simlib.py).
-- Installed (a wheel in any environment): the DBC and the example robots the wheel carries in
-  odo_tools/data/ (laid out as in the repository, can/ and host_sim/robots/), and libodosim.so
+- Installed (a wheel in any environment): the DBC, the example robots and odo-flash's openocd
+  configuration the wheel carries in odo_tools/data/ (laid out as in the repository: can/,
+  host_sim/robots/, hal/cortexm/openocd/), and libodosim.so
   from, in order: $ODO_BUILD_DIR/lib, next to the package (odo_tools/lib/), the prefix the
   .deb's odo-sim was installed under (PREFIX/bin/odo-sim on PATH -> PREFIX/lib), the
   directories of LD_LIBRARY_PATH, this environment's prefix, /usr/local/lib and /usr/lib.
@@ -38,7 +39,8 @@ def checkout_root() -> Path | None:
 
 
 def data_root() -> Path:
-    """The folder holding can/odometry.dbc and host_sim/robots/: the checkout, else the wheel's."""
+    """The folder holding can/, host_sim/robots/, hal/cortexm/openocd/: the checkout, else the
+    wheel's odo_tools/data."""
     return checkout_root() or DATA_DIR
 
 
