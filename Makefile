@@ -4,7 +4,7 @@ SHELL := /bin/bash
 .DEFAULT_GOAL := help
 JOBS ?= $(shell nproc)
 
-.PHONY: help deps build release cm4 test demo bench bench-target soak fuzz coverage flash flash-params flash-all package lock clean
+.PHONY: help deps build release cm4 test demo bench bench-target soak fuzz coverage format flash flash-params flash-all package lock clean
 
 help: ## list targets
 	@grep -E '^[a-z0-9-]+:.*## ' $(MAKEFILE_LIST) | awk -F':.*## ' '{printf "  make %-12s %s\n", $$1, $$2}'
@@ -59,6 +59,9 @@ coverage: deps ## firmware/ line and branch coverage from the Unity tests (gcovr
 	@gcovr --root . --filter 'firmware/' --exclude-unreachable-branches --print-summary \
 	  --txt build/coverage/coverage.txt build/coverage | tail -n 3
 	@echo "per file: build/coverage/coverage.txt"
+
+format: ## reformat every C file by .clang-format (the folders: tests/lint/clang_format.py); ctest lint.format checks it
+	@python3 tests/lint/clang_format.py . --fix
 
 package: release ## the .deb (CPack, release build) and the wheel, in build/release/package
 	@cd build/release && cpack -G DEB -B package >/dev/null && ls package/*.deb
