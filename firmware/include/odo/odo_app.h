@@ -30,6 +30,9 @@ extern "C" {
 #define ODO_APP_MAX_FRAMES 6U
 
 /// Flags byte of the POSE_THETA frames: what happened to that truck's pose this tick.
+// A table whose multi-line trailing comments clang-format 14 would turn into backslash
+// continuations (tests/python/test_can_dbc.py reads it): kept as written.
+// clang-format off
 #define ODO_POSE_FLAG_MISSING    0x01U ///< no wheel sample: pose held
 #define ODO_POSE_FLAG_JUMP       0x02U ///< implausible or ambiguous counter reading: pose held,
                                        ///< baseline re-taken
@@ -37,6 +40,7 @@ extern "C" {
 #define ODO_POSE_FLAG_IPEC_GATED 0x08U ///< IPEC is on but was skipped this tick (see faults)
 #define ODO_POSE_FLAG_RANGE      0x10U ///< position beyond ODO_POSE_LIMIT_MM_Q32: pose held
 #define ODO_POSE_FLAG_XY_SATURATED 0x20U ///< POSE_XY carries a saturated x or y (beyond 21.47 km)
+// clang-format on
 
 /// Application state. Plain data, caller-allocated (static on the target); no pointers inside,
 /// so it can be copied to checkpoint a run.
