@@ -41,7 +41,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     }
     if (odo_params_decode(buf, size, &p) == ODO_PARAMS_OK) {
         uint8_t a[ODO_PARAMS_SIZE], b[ODO_PARAMS_SIZE];
-        if (odo_params_encode(&p, a, sizeof a) != ODO_PARAMS_SIZE || odo_params_decode(a, sizeof a, &q) != ODO_PARAMS_OK ||
+        if (odo_params_encode(&p, a, sizeof a) != ODO_PARAMS_SIZE ||
+            odo_params_decode(a, sizeof a, &q) != ODO_PARAMS_OK ||
             odo_params_encode(&q, b, sizeof b) != ODO_PARAMS_SIZE || memcmp(a, b, sizeof a) != 0) {
             abort();
         }

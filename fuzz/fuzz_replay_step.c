@@ -47,8 +47,13 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     if (size < 1U) {
         return 0;
     }
-    static const uint32_t ids[] = {ODO_CAN_ID_WHEEL_COUNTS_A, ODO_CAN_ID_WHEEL_COUNTS_B, ODO_CAN_ID_LINK_ROTARY,
-                                   ODO_CAN_ID_LINK_LINEAR, ODO_CAN_ID_POSE_XY_A, ODO_CAN_ID_STATUS, 0x7FFU,
+    static const uint32_t ids[] = {ODO_CAN_ID_WHEEL_COUNTS_A,
+                                   ODO_CAN_ID_WHEEL_COUNTS_B,
+                                   ODO_CAN_ID_LINK_ROTARY,
+                                   ODO_CAN_ID_LINK_LINEAR,
+                                   ODO_CAN_ID_POSE_XY_A,
+                                   ODO_CAN_ID_STATUS,
+                                   0x7FFU,
                                    ODO_CAN_ID_WHEEL_COUNTS_A};
     static const uint8_t bits[] = {24U, 16U, 32U, 8U};
     odo_params_t p = g_params;

@@ -24,8 +24,8 @@
 
 typedef struct reg_node {
     struct reg_node *next;
-    int              is_dir;
-    char             path[];
+    int is_dir;
+    char path[];
 } reg_node_t;
 
 static reg_node_t *volatile g_reg = NULL;
@@ -222,7 +222,7 @@ static mode_t current_umask(void)
 }
 
 typedef struct parents {
-    size_t      n;
+    size_t n;
     reg_node_t *node[64];
 } parents_t;
 
@@ -355,8 +355,8 @@ int odo_out_check_inputs(const odo_out_inputs_t *ins, const char *path, char *er
             break;
         }
         if (stat(dir, &sb) == 0 && (hit = input_match(ins, &sb, true)) != NULL) {
-            return fail(err, errlen, "%s: the output lies inside the input folder %s; refusing to write there",
-                        path, hit);
+            return fail(err, errlen, "%s: the output lies inside the input folder %s; refusing to write there", path,
+                        hit);
         }
         if (strcmp(dir, ".") == 0 || strcmp(dir, "/") == 0) {
             break;
@@ -369,9 +369,8 @@ int odo_out_check_inputs(const odo_out_inputs_t *ins, const char *path, char *er
         if (getcwd(cwd, sizeof cwd) != NULL) {
             for (;;) {
                 if (stat(cwd, &sb) == 0 && (hit = input_match(ins, &sb, true)) != NULL) {
-                    return fail(err, errlen,
-                                "%s: the output lies inside the input folder %s; refusing to write there", path,
-                                hit);
+                    return fail(err, errlen, "%s: the output lies inside the input folder %s; refusing to write there",
+                                path, hit);
                 }
                 char *slash = strrchr(cwd, '/');
                 if (slash == NULL || slash == cwd) {
@@ -428,8 +427,7 @@ static int check_file_target(const char *path, char *err, size_t errlen)
     return 0;
 }
 
-int odo_out_file_begin(odo_out_file_t *o, const char *path, const odo_out_inputs_t *ins, char *err,
-                       size_t errlen)
+int odo_out_file_begin(odo_out_file_t *o, const char *path, const odo_out_inputs_t *ins, char *err, size_t errlen)
 {
     memset(o, 0, sizeof *o);
     char dir[PATH_MAX], base[PATH_MAX];
@@ -535,8 +533,7 @@ int odo_out_file_commit(odo_out_file_t *o, char *err, size_t errlen)
     return 0;
 }
 
-int odo_out_write(const char *path, const void *data, size_t len, const odo_out_inputs_t *ins, char *err,
-                  size_t errlen)
+int odo_out_write(const char *path, const void *data, size_t len, const odo_out_inputs_t *ins, char *err, size_t errlen)
 {
     odo_out_file_t o;
     if (odo_out_file_begin(&o, path, ins, err, errlen) != 0) {
@@ -558,22 +555,22 @@ typedef enum { DIR_FRESH, DIR_UPDATE, DIR_FORCE } dir_mode_t;
 
 typedef struct {
     reg_node_t *reg; /* the temp file or sub-folder */
-    int         is_dir;
-    char        name[];
+    int is_dir;
+    char name[];
 } entry_t;
 
 struct odo_out_dir {
-    char              path[PATH_MAX];
-    char              tmp[PATH_MAX];
-    char              tool[64];
-    dir_mode_t        mode;
-    odo_out_inputs_t  ins;
-    reg_node_t       *tmp_reg;
-    parents_t         made;
-    entry_t         **e;    /* files and sub-folders written, in order */
-    size_t            n_e, cap_e;
-    char            **old;  /* previous manifest's files (DIR_UPDATE) */
-    size_t            n_old;
+    char path[PATH_MAX];
+    char tmp[PATH_MAX];
+    char tool[64];
+    dir_mode_t mode;
+    odo_out_inputs_t ins;
+    reg_node_t *tmp_reg;
+    parents_t made;
+    entry_t **e; /* files and sub-folders written, in order */
+    size_t n_e, cap_e;
+    char **old; /* previous manifest's files (DIR_UPDATE) */
+    size_t n_old;
 };
 
 /// A manifest name: relative, no "." / ".." / empty components, no control characters.
@@ -719,8 +716,8 @@ void odo_out_dir_abort(odo_out_dir_t *d)
     free(d);
 }
 
-odo_out_dir_t *odo_out_dir_begin(const char *path, const char *tool, bool force, const odo_out_inputs_t *ins,
-                                 char *err, size_t errlen)
+odo_out_dir_t *odo_out_dir_begin(const char *path, const char *tool, bool force, const odo_out_inputs_t *ins, char *err,
+                                 size_t errlen)
 {
     char dir[PATH_MAX], base[PATH_MAX];
     if (path == NULL || split(path, dir, base) != 0) {
@@ -787,8 +784,7 @@ odo_out_dir_t *odo_out_dir_begin(const char *path, const char *tool, bool force,
         return NULL;
     }
     for (int attempt = 0;; ++attempt) {
-        const int w = snprintf(d->tmp, sizeof d->tmp, "%s/.%s.tmp-%ld-%06lx", dir, base, (long)getpid(),
-                               next_suffix());
+        const int w = snprintf(d->tmp, sizeof d->tmp, "%s/.%s.tmp-%ld-%06lx", dir, base, (long)getpid(), next_suffix());
         if (w < 0 || (size_t)w >= sizeof d->tmp) {
             (void)fail(err, errlen, "%s: path too long", path);
             odo_out_dir_abort(d);
@@ -944,8 +940,7 @@ int odo_out_dir_adopt(odo_out_dir_t *d, const char *name, char *err, size_t errl
 }
 
 /// Write the manifest listing names (files only) to path via a temp file in the same folder.
-static int write_manifest(const char *dir, const char *tool, char *const *names, size_t n, char *err,
-                          size_t errlen)
+static int write_manifest(const char *dir, const char *tool, char *const *names, size_t n, char *err, size_t errlen)
 {
     char path[PATH_MAX];
     if (join(path, sizeof path, dir, ODO_OUT_MANIFEST) != 0) {
@@ -1006,8 +1001,7 @@ int odo_out_dir_commit(odo_out_dir_t *d, char *err, size_t errlen)
     const mode_t um = current_umask();
     int rc = 0;
     if (d->mode == DIR_FRESH) {
-        if (write_manifest(d->tmp, d->tool, names, n, err, errlen) != 0 ||
-            chmod(d->tmp, 0777 & ~um) != 0) {
+        if (write_manifest(d->tmp, d->tool, names, n, err, errlen) != 0 || chmod(d->tmp, 0777 & ~um) != 0) {
             rc = -1;
         } else {
             /* Checked again: something may have appeared at the target during the run. */

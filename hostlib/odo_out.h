@@ -50,8 +50,8 @@ typedef struct {
     struct {
         dev_t dev;
         ino_t ino;
-        bool  is_dir;
-        char  path[PATH_MAX];
+        bool is_dir;
+        char path[PATH_MAX];
     } in[32];
 } odo_out_inputs_t;
 
@@ -69,16 +69,15 @@ int odo_out_check_inputs(const odo_out_inputs_t *ins, const char *path, char *er
 /// One file being written. `f` is the stream to write to (fully buffered).
 typedef struct {
     FILE *f;
-    char  path[PATH_MAX]; /* target */
-    char  tmp[PATH_MAX];  /* temp beside it; "" once committed or aborted */
-    void *reg;            /* cleanup registration */
-    void *parents;        /* parent folders this file created */
+    char path[PATH_MAX]; /* target */
+    char tmp[PATH_MAX];  /* temp beside it; "" once committed or aborted */
+    void *reg;           /* cleanup registration */
+    void *parents;       /* parent folders this file created */
 } odo_out_file_t;
 
 /// Check the target (regular file or absent, not an input; ins may be NULL), create missing
 /// parents and open a fresh temp beside it. On failure nothing is left behind.
-int odo_out_file_begin(odo_out_file_t *o, const char *path, const odo_out_inputs_t *ins, char *err,
-                       size_t errlen);
+int odo_out_file_begin(odo_out_file_t *o, const char *path, const odo_out_inputs_t *ins, char *err, size_t errlen);
 
 /// Flush, fsync, close and rename into place (the target is checked again just before). On failure
 /// the temp is removed and the target is as it was.
@@ -97,8 +96,8 @@ typedef struct odo_out_dir odo_out_dir_t;
 /// Check the target folder (absent, empty, holding `tool`'s manifest, or any folder with force;
 /// not an input nor inside one; not a symlink or a non-folder), create missing parents and a fresh
 /// temp folder beside it. Returns NULL with err set on failure (nothing left behind).
-odo_out_dir_t *odo_out_dir_begin(const char *path, const char *tool, bool force, const odo_out_inputs_t *ins,
-                                 char *err, size_t errlen);
+odo_out_dir_t *odo_out_dir_begin(const char *path, const char *tool, bool force, const odo_out_inputs_t *ins, char *err,
+                                 size_t errlen);
 
 /// Open `name` (relative, may contain subfolders) for writing inside the temp folder. The caller
 /// writes and fclose()s it (checking the result) before odo_out_dir_commit. NULL with err set on a

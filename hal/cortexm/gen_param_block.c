@@ -48,8 +48,7 @@ int main(int argc, char **argv)
     odo_params_t back;
     odo_params_status_t st = odo_params_decode(block, sizeof block, &back);
     if (st != ODO_PARAMS_OK) {
-        (void)fprintf(stderr, "gen_param_block: the default block does not decode: %s\n",
-                odo_params_status_str(st));
+        (void)fprintf(stderr, "gen_param_block: the default block does not decode: %s\n", odo_params_status_str(st));
         return EXIT_FAILURE;
     }
 
@@ -59,18 +58,18 @@ int main(int argc, char **argv)
         return EXIT_FAILURE;
     }
     (void)fprintf(f,
-            "/* Generated at build time by hal/cortexm/gen_param_block.c from odo_params_defaults().\n"
-            " * Do not edit: change the defaults in firmware/src/odo_params.c, or patch a built image\n"
-            " * with `odo-calib write`. Layout: firmware/include/odo/odo_params.h. */\n"
-            "#include \"odo_board.h\"\n\n"
-            "/* The block's size as a link-time constant, for odo_cm4.ld's ASSERT on .odo_params. */\n"
-            "__asm__(\".global __odo_params_block_size\\n\\t.set __odo_params_block_size, %u\");\n\n"
-            "__attribute__((section(\".odo_params\"), used, aligned(4)))\n"
-            "const uint8_t odo_param_block[ODO_PARAMS_SIZE] = {\n",
-            ODO_PARAMS_SIZE);
+                  "/* Generated at build time by hal/cortexm/gen_param_block.c from odo_params_defaults().\n"
+                  " * Do not edit: change the defaults in firmware/src/odo_params.c, or patch a built image\n"
+                  " * with `odo-calib write`. Layout: firmware/include/odo/odo_params.h. */\n"
+                  "#include \"odo_board.h\"\n\n"
+                  "/* The block's size as a link-time constant, for odo_cm4.ld's ASSERT on .odo_params. */\n"
+                  "__asm__(\".global __odo_params_block_size\\n\\t.set __odo_params_block_size, %u\");\n\n"
+                  "__attribute__((section(\".odo_params\"), used, aligned(4)))\n"
+                  "const uint8_t odo_param_block[ODO_PARAMS_SIZE] = {\n",
+                  ODO_PARAMS_SIZE);
     for (size_t i = 0; i < sizeof block; ++i) {
         (void)fprintf(f, "%s0x%02XU,%s", (i % 12U) == 0U ? "    " : " ", (unsigned)block[i],
-                ((i % 12U) == 11U || i + 1U == sizeof block) ? "\n" : "");
+                      ((i % 12U) == 11U || i + 1U == sizeof block) ? "\n" : "");
     }
     (void)fprintf(f, "};\n");
     if (ferror(f) != 0) {

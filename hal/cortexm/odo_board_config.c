@@ -10,10 +10,10 @@
 #include "odo_board.h"
 
 #define GPIO(port) ((odo_stm32_gpio_t *)ODO_STM32_GPIO_BASE(port))
-#define PA 0U
-#define PB 1U
-#define PE 4U
-#define TIM(base) ((odo_stm32_tim_t *)(base))
+#define PA         0U
+#define PB         1U
+#define PE         4U
+#define TIM(base)  ((odo_stm32_tim_t *)(base))
 
 #ifndef ODO_CM4_WHEEL_SOURCE
 #define ODO_CM4_WHEEL_SOURCE ODO_WHEELS_ENCODER
@@ -34,22 +34,22 @@ const odo_board_config_t odo_board_config = {
     .watchdog_ms = 200U,
     .polls = 200000U,
     .encoder_filter = 3U,
-    .truck = {
-        {.source = ODO_CM4_WHEEL_SOURCE,
-         .tim = {TIM(ODO_STM32_TIM2_BASE), TIM(ODO_STM32_TIM5_BASE)},
-         .tim_apb1enr = {ODO_RCC_APB1ENR_TIM2, ODO_RCC_APB1ENR_TIM5},
-         .tim_bits = {32U, 32U},
-         .ti = {{{GPIO(PA), PA, 15U, 1U}, {GPIO(PB), PB, 3U, 1U}},
-                {{GPIO(PA), PA, 0U, 2U}, {GPIO(PA), PA, 1U, 2U}}},
-         .hctl_chip = {0U, 1U}},
-        {.source = ODO_CM4_WHEEL_SOURCE,
-         .tim = {TIM(ODO_STM32_TIM3_BASE), TIM(ODO_STM32_TIM4_BASE)},
-         .tim_apb1enr = {ODO_RCC_APB1ENR_TIM3, ODO_RCC_APB1ENR_TIM4},
-         .tim_bits = {16U, 16U},
-         .ti = {{{GPIO(PA), PA, 6U, 2U}, {GPIO(PA), PA, 7U, 2U}},
-                {{GPIO(PB), PB, 6U, 2U}, {GPIO(PB), PB, 7U, 2U}}},
-         .hctl_chip = {2U, 3U}},
-    },
+    .truck =
+        {
+            {.source = ODO_CM4_WHEEL_SOURCE,
+             .tim = {TIM(ODO_STM32_TIM2_BASE), TIM(ODO_STM32_TIM5_BASE)},
+             .tim_apb1enr = {ODO_RCC_APB1ENR_TIM2, ODO_RCC_APB1ENR_TIM5},
+             .tim_bits = {32U, 32U},
+             .ti = {{{GPIO(PA), PA, 15U, 1U}, {GPIO(PB), PB, 3U, 1U}},
+                    {{GPIO(PA), PA, 0U, 2U}, {GPIO(PA), PA, 1U, 2U}}},
+             .hctl_chip = {0U, 1U}},
+            {.source = ODO_CM4_WHEEL_SOURCE,
+             .tim = {TIM(ODO_STM32_TIM3_BASE), TIM(ODO_STM32_TIM4_BASE)},
+             .tim_apb1enr = {ODO_RCC_APB1ENR_TIM3, ODO_RCC_APB1ENR_TIM4},
+             .tim_bits = {16U, 16U},
+             .ti = {{{GPIO(PA), PA, 6U, 2U}, {GPIO(PA), PA, 7U, 2U}}, {{GPIO(PB), PB, 6U, 2U}, {GPIO(PB), PB, 7U, 2U}}},
+             .hctl_chip = {2U, 3U}},
+        },
     .hctl = {GPIO(PE), GPIO(PE), 8U, 9U, 10U, {11U, 12U, 13U, 14U}, 4U, 8U},
     .hctl_port_index = {PE, PE},
 };

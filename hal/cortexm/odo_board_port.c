@@ -60,8 +60,8 @@ void odo_board_init(hal_ctx_t *hal, const odo_board_config_t *cfg)
         }
     }
     if (any_source(cfg, ODO_WHEELS_HCTL)) {
-        odo_reg_modify(&rcc->AHB1ENR, 0U, ODO_RCC_AHB1ENR_GPIO(cfg->hctl_port_index[0]) |
-                                              ODO_RCC_AHB1ENR_GPIO(cfg->hctl_port_index[1]));
+        odo_reg_modify(&rcc->AHB1ENR, 0U,
+                       ODO_RCC_AHB1ENR_GPIO(cfg->hctl_port_index[0]) | ODO_RCC_AHB1ENR_GPIO(cfg->hctl_port_index[1]));
         odo_hctl_bus_init(&cfg->hctl);
     }
 
@@ -164,12 +164,9 @@ bool hal_wheel_read(hal_ctx_t *ctx, uint8_t truck, odo_wheel_input_t *out)
         out->right_raw = odo_hctl_read_position(&ctx->cfg->hctl, io->hctl_chip[1]);
         out->bits = ODO_HCTL_BITS;
         break;
-    case ODO_WHEELS_CAN:
-        *out = ctx->can_wheel[truck];
-        return true;
+    case ODO_WHEELS_CAN: *out = ctx->can_wheel[truck]; return true;
     case ODO_WHEELS_NONE:
-    default:
-        return false;
+    default: return false;
     }
     out->present = true;
     out->seq = ctx->seq[truck]++;

@@ -43,8 +43,8 @@ bool odo_bxcan_timing(uint32_t pclk1_hz, uint32_t bitrate, uint32_t *btr, uint32
     return found;
 }
 
-odo_bxcan_status_t odo_bxcan_init(odo_stm32_can_t *can, uint32_t pclk1_hz, uint32_t bitrate,
-                                  const uint32_t *ids, uint8_t n_ids, uint32_t polls)
+odo_bxcan_status_t odo_bxcan_init(odo_stm32_can_t *can, uint32_t pclk1_hz, uint32_t bitrate, const uint32_t *ids,
+                                  uint8_t n_ids, uint32_t polls)
 {
     uint32_t btr = 0U;
     if (!odo_bxcan_timing(pclk1_hz, bitrate, &btr, NULL)) {
@@ -160,7 +160,4 @@ bool odo_bxcan_recv(odo_stm32_can_t *can, odo_can_frame_t *f, uint8_t *raw_dlc, 
     return true;
 }
 
-bool odo_bxcan_bus_off(odo_stm32_can_t *can)
-{
-    return (odo_reg_read(&can->ESR) & ODO_CAN_ESR_BOFF) != 0U;
-}
+bool odo_bxcan_bus_off(odo_stm32_can_t *can) { return (odo_reg_read(&can->ESR) & ODO_CAN_ESR_BOFF) != 0U; }

@@ -3,9 +3,9 @@
 
 #include "odo_reg.h"
 
-#define PLLN 336U
-#define PLLP 2U
-#define PLLQ 7U
+#define PLLN                     336U
+#define PLLP                     2U
+#define PLLQ                     7U
 #define FLASH_WAIT_STATES_168MHZ 5U /* RM0090 3.5.1: 150 < HCLK <= 168 MHz at 2.7-3.6 V */
 
 static odo_clock_t tree(odo_clock_source_t source, uint32_t sysclk_hz, int divided)
@@ -20,8 +20,7 @@ static odo_clock_t tree(odo_clock_source_t source, uint32_t sysclk_hz, int divid
     return c;
 }
 
-odo_clock_t odo_clock_init(odo_stm32_rcc_t *rcc, odo_stm32_flash_t *flash, uint32_t hse_hz,
-                           uint32_t polls)
+odo_clock_t odo_clock_init(odo_stm32_rcc_t *rcc, odo_stm32_flash_t *flash, uint32_t hse_hz, uint32_t polls)
 {
     /* Start from the reset state: on HSI, PLL off (it cannot be reconfigured while on). */
     odo_reg_modify(&rcc->CR, 0U, ODO_RCC_CR_HSION);
@@ -47,8 +46,7 @@ odo_clock_t odo_clock_init(odo_stm32_rcc_t *rcc, odo_stm32_flash_t *flash, uint3
     }
     /* Wait states before the clock goes up, prescalers before the switch. */
     odo_reg_modify(&flash->ACR, ODO_FLASH_ACR_LATENCY_MASK,
-                   FLASH_WAIT_STATES_168MHZ | ODO_FLASH_ACR_PRFTEN | ODO_FLASH_ACR_ICEN |
-                       ODO_FLASH_ACR_DCEN);
+                   FLASH_WAIT_STATES_168MHZ | ODO_FLASH_ACR_PRFTEN | ODO_FLASH_ACR_ICEN | ODO_FLASH_ACR_DCEN);
     odo_reg_modify(&rcc->CFGR, ODO_RCC_CFGR_HPRE_MASK | ODO_RCC_CFGR_PPRE1_MASK | ODO_RCC_CFGR_PPRE2_MASK,
                    ODO_RCC_CFGR_PPRE1_DIV4 | ODO_RCC_CFGR_PPRE2_DIV2);
     odo_reg_modify(&rcc->CFGR, ODO_RCC_CFGR_SW_MASK, ODO_RCC_CFGR_SW_PLL);

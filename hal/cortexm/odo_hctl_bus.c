@@ -3,18 +3,12 @@
 
 #include "odo_reg.h"
 
-#define DATA_MODER_MASK 0xFFFFU  /* pins 0-7, two bits each */
-#define DATA_MODER_OUT  0x5555U  /* 01 = general-purpose output */
+#define DATA_MODER_MASK 0xFFFFU /* pins 0-7, two bits each */
+#define DATA_MODER_OUT  0x5555U /* 01 = general-purpose output */
 
-static void pin_high(odo_stm32_gpio_t *g, uint8_t pin)
-{
-    odo_reg_write(&g->BSRR, (uint32_t)1U << pin);
-}
+static void pin_high(odo_stm32_gpio_t *g, uint8_t pin) { odo_reg_write(&g->BSRR, (uint32_t)1U << pin); }
 
-static void pin_low(odo_stm32_gpio_t *g, uint8_t pin)
-{
-    odo_reg_write(&g->BSRR, (uint32_t)1U << (16U + pin));
-}
+static void pin_low(odo_stm32_gpio_t *g, uint8_t pin) { odo_reg_write(&g->BSRR, (uint32_t)1U << (16U + pin)); }
 
 static void pin_output(odo_stm32_gpio_t *g, uint8_t pin)
 {

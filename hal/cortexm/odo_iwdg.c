@@ -37,7 +37,4 @@ bool odo_iwdg_start(odo_stm32_iwdg_t *iwdg, uint32_t timeout_ms, uint32_t polls)
     return ok;
 }
 
-void odo_iwdg_refresh(odo_stm32_iwdg_t *iwdg)
-{
-    odo_reg_write(&iwdg->KR, ODO_IWDG_KEY_RELOAD);
-}
+void odo_iwdg_refresh(odo_stm32_iwdg_t *iwdg) { odo_reg_write(&iwdg->KR, ODO_IWDG_KEY_RELOAD); }

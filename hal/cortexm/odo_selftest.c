@@ -17,8 +17,8 @@ static const int16_t k_synthetic_deltas[][2] = {
 #define ODO_SELFTEST_BITS      24U
 #define ODO_SELFTEST_TICK_US   40000U
 
-void odo_selftest_run(odo_app_t *app, odo_tick_input_t *in, odo_tick_output_t *out,
-                      const uint8_t *block, size_t len, odo_board_selftest_t *r)
+void odo_selftest_run(odo_app_t *app, odo_tick_input_t *in, odo_tick_output_t *out, const uint8_t *block, size_t len,
+                      odo_board_selftest_t *r)
 {
     memset(r, 0, sizeof *r);
     r->params_status = (uint32_t)odo_app_init(app, block, len);

@@ -34,10 +34,7 @@ bool odo_tick_timer_elapsed(odo_stm32_tim_t *tim)
     return true;
 }
 
-uint32_t odo_tick_timer_us(odo_stm32_tim_t *tim)
-{
-    return odo_reg_read(&tim->CNT);
-}
+uint32_t odo_tick_timer_us(odo_stm32_tim_t *tim) { return odo_reg_read(&tim->CNT); }
 
 bool odo_encoder_init(odo_stm32_tim_t *tim, uint8_t bits, uint8_t filter, bool invert)
 {
@@ -47,8 +44,8 @@ bool odo_encoder_init(odo_stm32_tim_t *tim, uint8_t bits, uint8_t filter, bool i
     odo_reg_write(&tim->CR1, 0U);
     odo_reg_write(&tim->SMCR, 0U);
     odo_reg_write(&tim->CCER, 0U); /* CCxE off while the channel mode is written (18.4.7) */
-    odo_reg_write(&tim->CCMR1, ODO_TIM_CCMR1_CC1S_TI1 | ODO_TIM_CCMR1_CC2S_TI2 |
-                                   ODO_TIM_CCMR1_IC1F(filter & 0xFU) | ODO_TIM_CCMR1_IC2F(filter & 0xFU));
+    odo_reg_write(&tim->CCMR1, ODO_TIM_CCMR1_CC1S_TI1 | ODO_TIM_CCMR1_CC2S_TI2 | ODO_TIM_CCMR1_IC1F(filter & 0xFU) |
+                                   ODO_TIM_CCMR1_IC2F(filter & 0xFU));
     odo_reg_write(&tim->CCER, invert ? (1U << 1) : 0U); /* CC1P: TI1 inverted -> counts down */
     odo_reg_write(&tim->PSC, 0U);
     odo_reg_write(&tim->ARR, bits == 32U ? 0xFFFFFFFFU : 0xFFFFU);
@@ -58,7 +55,4 @@ bool odo_encoder_init(odo_stm32_tim_t *tim, uint8_t bits, uint8_t filter, bool i
     return true;
 }
 
-uint32_t odo_encoder_read(odo_stm32_tim_t *tim)
-{
-    return odo_reg_read(&tim->CNT);
-}
+uint32_t odo_encoder_read(odo_stm32_tim_t *tim) { return odo_reg_read(&tim->CNT); }

@@ -21,9 +21,9 @@ typedef struct {
     // cppcheck-suppress unusedStructMember ; read by the core at reset
     const uint32_t *initial_sp;
     // cppcheck-suppress unusedStructMember ; read by the core on each exception
-    odo_isr_t       exception[15]; ///< Reset (1) .. SysTick (15)
+    odo_isr_t exception[15]; ///< Reset (1) .. SysTick (15)
     // cppcheck-suppress unusedStructMember ; read by the NVIC on each interrupt
-    odo_isr_t       irq[ODO_BOARD_IRQ_COUNT];
+    odo_isr_t irq[ODO_BOARD_IRQ_COUNT];
 } odo_vector_table_t;
 
 // Provided by odo_cm4.ld.
@@ -44,39 +44,41 @@ void DebugMon_Handler(void) __attribute__((weak, alias("Default_Handler")));
 void PendSV_Handler(void) __attribute__((weak, alias("Default_Handler")));
 void SysTick_Handler(void) __attribute__((weak, alias("Default_Handler")));
 
-#define ODO_H1 Default_Handler
-#define ODO_H2 ODO_H1, ODO_H1
-#define ODO_H4 ODO_H2, ODO_H2
-#define ODO_H8 ODO_H4, ODO_H4
+#define ODO_H1  Default_Handler
+#define ODO_H2  ODO_H1, ODO_H1
+#define ODO_H4  ODO_H2, ODO_H2
+#define ODO_H8  ODO_H4, ODO_H4
 #define ODO_H16 ODO_H8, ODO_H8
 #define ODO_H32 ODO_H16, ODO_H16
 #define ODO_H64 ODO_H32, ODO_H32
 
 /// Placed first in flash by odo_cm4.ld (section .isr_vector, KEEP).
-__attribute__((section(".isr_vector"), used))
-static const odo_vector_table_t odo_vector_table = {
+__attribute__((section(".isr_vector"), used)) static const odo_vector_table_t odo_vector_table = {
     .initial_sp = _estack,
-    .exception = {
-        Reset_Handler,
-        NMI_Handler,
-        HardFault_Handler,
-        MemManage_Handler,
-        BusFault_Handler,
-        UsageFault_Handler,
-        0, 0, 0, 0, // reserved
-        SVC_Handler,
-        DebugMon_Handler,
-        0, // reserved
-        PendSV_Handler,
-        SysTick_Handler,
-    },
+    .exception =
+        {
+            Reset_Handler,
+            NMI_Handler,
+            HardFault_Handler,
+            MemManage_Handler,
+            BusFault_Handler,
+            UsageFault_Handler,
+            0,
+            0,
+            0,
+            0, // reserved
+            SVC_Handler,
+            DebugMon_Handler,
+            0, // reserved
+            PendSV_Handler,
+            SysTick_Handler,
+        },
     // No peripheral interrupt is enabled yet; every line traps in Default_Handler.
-    .irq = { ODO_H64, ODO_H16, ODO_H2 },
+    .irq = {ODO_H64, ODO_H16, ODO_H2},
 };
 
 /// C99 static assert: the vector table must be a packed array of 32-bit words.
-typedef char odo_vector_table_is_packed[
-    (sizeof(odo_vector_table_t) == 4U * (16U + ODO_BOARD_IRQ_COUNT)) ? 1 : -1];
+typedef char odo_vector_table_is_packed[(sizeof(odo_vector_table_t) == 4U * (16U + ODO_BOARD_IRQ_COUNT)) ? 1 : -1];
 
 void Reset_Handler(void)
 {

@@ -46,10 +46,10 @@ typedef enum {
 
 /// One parsed line, as the log wrote it.
 typedef struct {
-    uint64_t        t_us;                        ///< timestamp, microseconds
-    odo_can_frame_t frame;                       ///< id without flag bits; flags ODO_CAN_FLAG_*
-    char            iface[CANDUMP_IFACE_MAX + 1]; ///< NUL-terminated
-    char            direction;                   ///< 'R', 'T', or 0 when the line has none
+    uint64_t t_us;                     ///< timestamp, microseconds
+    odo_can_frame_t frame;             ///< id without flag bits; flags ODO_CAN_FLAG_*
+    char iface[CANDUMP_IFACE_MAX + 1]; ///< NUL-terminated
+    char direction;                    ///< 'R', 'T', or 0 when the line has none
 } candump_line_t;
 
 /// Parse `len` bytes of one line (without or with its trailing newline). Returns CANDUMP_OK,

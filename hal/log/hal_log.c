@@ -58,7 +58,7 @@ static long next_line(hal_log_t *l)
         }
         if (l->end == HAL_LOG_CHUNK) {
             (void)snprintf(l->err, sizeof l->err, "%s:%llu: line longer than %u bytes", l->path,
-                     (unsigned long long)l->line_no + 1U, HAL_LOG_CHUNK);
+                           (unsigned long long)l->line_no + 1U, HAL_LOG_CHUNK);
             return -1;
         }
         const size_t got = fread(l->buf + l->end, 1U, HAL_LOG_CHUNK - l->end, l->f);
@@ -66,7 +66,7 @@ static long next_line(hal_log_t *l)
         if (got == 0U) {
             if (ferror(l->f)) {
                 (void)snprintf(l->err, sizeof l->err, "%s:%llu: read error: %s", l->path,
-                         (unsigned long long)l->line_no + 1U, strerror(errno));
+                               (unsigned long long)l->line_no + 1U, strerror(errno));
                 return -1;
             }
             l->eof = true;

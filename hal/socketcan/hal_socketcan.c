@@ -46,8 +46,9 @@ static int open_socket(hal_socketcan_t *s)
     if (fd < 0) {
         if (errno == EAFNOSUPPORT) {
             (void)snprintf(s->err, sizeof s->err,
-                     "this kernel has no SocketCAN (socket(AF_CAN): %s); load the can and can_raw "
-                     "modules", strerror(errno));
+                           "this kernel has no SocketCAN (socket(AF_CAN): %s); load the can and can_raw "
+                           "modules",
+                           strerror(errno));
         } else {
             (void)snprintf(s->err, sizeof s->err, "socket(AF_CAN): %s", strerror(errno));
         }

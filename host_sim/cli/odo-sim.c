@@ -29,37 +29,36 @@
 
 static void usage(FILE *f)
 {
-    fprintf(f,
-            "usage: odo-sim --experiment NAME --vehicle labmate|clapper|set --scenario S.json --out DIR\n"
-            "               [--robot R.json] [--params P.json|P.bin] [--runs N] [--bumps N]\n"
-            "               [--ipec off|on|paper|estimator] [--seed S] [--log-start now|SECONDS]\n"
-            "               [--force] [--quiet]\n"
-            "       odo-sim --list-effects [--json]\n"
-            "       odo-sim --help | --version\n"
-            "\n"
-            "Experiments (000, 004): umbmark, umbmark-ext, straight-36m, rect-7x4. Closed paths run N\n"
-            "times in each direction (cw, ccw; default N = 5); straight-36m runs N times.\n"
-            "--robot defaults to host_sim/robots/<vehicle>.json. --seed overrides the scenario's seed.\n"
-            "Writes DIR/run-<dir>-NN.log (sensor frames, candump -l), DIR/run-<dir>-NN.truth.csv,\n"
-            "DIR/returns.csv and DIR/summary.json; missing parent folders are created. DIR is built\n"
-            "beside itself and renamed into place; an existing DIR must be empty or hold a previous\n"
-            "odo-sim output (its .odo-manifest: only the files listed there are replaced or removed);\n"
-            "--force writes into any other folder, replacing same-named files and removing nothing.\n"
-            "--log-start: the logs' first timestamp, whole seconds since the epoch (default\n"
-            "$SOURCE_DATE_EPOCH if set, else now; 0 for reproducible logs). The truth CSVs' t_s is\n"
-            "on the same clock.\n"
-            "--params P.json|P.bin: run the firmware with this parameter block's calibration (Ed, Eb,\n"
-            "Es per truck, e.g. from odo-calib umbmark --out-params); the world keeps the robot's true\n"
-            "geometry, and the block's nominal geometry must match the robot description's.\n"
-            "Exit status: 0 ok, 1 rejected input or I/O error, 2 usage error.\n");
+    fprintf(f, "usage: odo-sim --experiment NAME --vehicle labmate|clapper|set --scenario S.json --out DIR\n"
+               "               [--robot R.json] [--params P.json|P.bin] [--runs N] [--bumps N]\n"
+               "               [--ipec off|on|paper|estimator] [--seed S] [--log-start now|SECONDS]\n"
+               "               [--force] [--quiet]\n"
+               "       odo-sim --list-effects [--json]\n"
+               "       odo-sim --help | --version\n"
+               "\n"
+               "Experiments (000, 004): umbmark, umbmark-ext, straight-36m, rect-7x4. Closed paths run N\n"
+               "times in each direction (cw, ccw; default N = 5); straight-36m runs N times.\n"
+               "--robot defaults to host_sim/robots/<vehicle>.json. --seed overrides the scenario's seed.\n"
+               "Writes DIR/run-<dir>-NN.log (sensor frames, candump -l), DIR/run-<dir>-NN.truth.csv,\n"
+               "DIR/returns.csv and DIR/summary.json; missing parent folders are created. DIR is built\n"
+               "beside itself and renamed into place; an existing DIR must be empty or hold a previous\n"
+               "odo-sim output (its .odo-manifest: only the files listed there are replaced or removed);\n"
+               "--force writes into any other folder, replacing same-named files and removing nothing.\n"
+               "--log-start: the logs' first timestamp, whole seconds since the epoch (default\n"
+               "$SOURCE_DATE_EPOCH if set, else now; 0 for reproducible logs). The truth CSVs' t_s is\n"
+               "on the same clock.\n"
+               "--params P.json|P.bin: run the firmware with this parameter block's calibration (Ed, Eb,\n"
+               "Es per truck, e.g. from odo-calib umbmark --out-params); the world keeps the robot's true\n"
+               "geometry, and the block's nominal geometry must match the robot description's.\n"
+               "Exit status: 0 ok, 1 rejected input or I/O error, 2 usage error.\n");
 }
 
 typedef struct {
-    FILE    *log;
-    FILE    *truth;
+    FILE *log;
+    FILE *truth;
     uint64_t start_us; /* --log-start: added to every frame's time */
     unsigned trucks;
-    int      io_error;
+    int io_error;
 } run_files_t;
 
 static void write_sensor_frames(run_files_t *rf, const sim_tick_t *tk)
@@ -95,10 +94,9 @@ static void on_tick(void *user, const sim_tick_t *tk)
     const double deg = 180.0 / M_PI;
     /* on the log's clock: a whole-second start (--log-start) plus the run's time */
     fprintf(rf->truth, "%.3f,%.4f,%.4f,%.6f,%.4f,%.4f,%.6f,%.6f,%.6f,%.4f,",
-            (double)(rf->start_us / 1000000U) + tk->t_s, tk->truth[0].x_mm,
-            tk->truth[0].y_mm, tk->truth[0].theta_rad * deg, tk->truth[1].x_mm, tk->truth[1].y_mm,
-            tk->truth[1].theta_rad * deg, tk->link.alpha_rad * deg, tk->link.beta_rad * deg,
-            tk->link.length_mm);
+            (double)(rf->start_us / 1000000U) + tk->t_s, tk->truth[0].x_mm, tk->truth[0].y_mm,
+            tk->truth[0].theta_rad * deg, tk->truth[1].x_mm, tk->truth[1].y_mm, tk->truth[1].theta_rad * deg,
+            tk->link.alpha_rad * deg, tk->link.beta_rad * deg, tk->link.length_mm);
     for (size_t i = 0; i < tk->n_events; ++i) {
         const sim_bump_event_t *e = &tk->events[i];
         fprintf(rf->truth, "%sbump:%c:%s:h%.3f:x%.3f:y%.3f", i ? "|" : "", e->truck ? 'B' : 'A',
@@ -107,8 +105,7 @@ static void on_tick(void *user, const sim_tick_t *tk)
     fputc('\n', rf->truth);
 }
 
-static int write_returns(odo_out_dir_t *dir, const sim_return_t *r, size_t n, int straight, char *err,
-                         size_t errlen)
+static int write_returns(odo_out_dir_t *dir, const sim_return_t *r, size_t n, int straight, char *err, size_t errlen)
 {
     FILE *f = odo_out_dir_fopen(dir, "returns.csv", err, errlen);
     if (f == NULL) {
@@ -117,14 +114,13 @@ static int write_returns(odo_out_dir_t *dir, const sim_return_t *r, size_t n, in
     fprintf(f, "run,direction,x_abs_mm,y_abs_mm,theta_abs_deg,x_calc_mm,y_calc_mm,theta_calc_deg\n");
     for (size_t i = 0; i < n; ++i) {
         fprintf(f, "%u,%s,%.3f,%.3f,%.4f,%.3f,%.3f,%.4f\n", r[i].run, straight ? "fwd" : (r[i].ccw ? "ccw" : "cw"),
-                r[i].x_abs_mm, r[i].y_abs_mm, r[i].theta_abs_deg, r[i].x_calc_mm, r[i].y_calc_mm,
-                r[i].theta_calc_deg);
+                r[i].x_abs_mm, r[i].y_abs_mm, r[i].theta_abs_deg, r[i].x_calc_mm, r[i].y_calc_mm, r[i].theta_calc_deg);
     }
     return fclose(f) == 0 ? 0 : -1;
 }
 
-static int write_summary(odo_out_dir_t *dir, const char *experiment, const char *vehicle, unsigned runs,
-                         uint64_t seed, const sim_return_t *r, size_t n, int straight, char *err, size_t errlen)
+static int write_summary(odo_out_dir_t *dir, const char *experiment, const char *vehicle, unsigned runs, uint64_t seed,
+                         const sim_return_t *r, size_t n, int straight, char *err, size_t errlen)
 {
     sim_summary_t s;
     sim_summarise(r, n, &s);
@@ -132,15 +128,18 @@ static int write_summary(odo_out_dir_t *dir, const char *experiment, const char 
     if (f == NULL) {
         return -1;
     }
-    fprintf(f, "{\n  \"experiment\": \"%s\",\n  \"vehicle\": \"%s\",\n  \"runs_per_direction\": %u,\n"
-               "  \"seed\": %" PRIu64 ",\n",
+    fprintf(f,
+            "{\n  \"experiment\": \"%s\",\n  \"vehicle\": \"%s\",\n  \"runs_per_direction\": %u,\n"
+            "  \"seed\": %" PRIu64 ",\n",
             experiment, vehicle, runs, seed);
-    fprintf(f, "  \"emax_syst_mm\": %.3f,\n  \"cg_cw_mm\": [%.3f, %.3f],\n  \"cg_ccw_mm\": [%.3f, %.3f],\n"
-               "  \"sigma_mm\": %.3f,\n  \"sem_mm\": %.3f,\n  \"avg_abs_theta_err_deg\": %.4f,\n  \"runs\": [\n",
-            s.emax_syst_mm, s.cg_cw_mm[0], s.cg_cw_mm[1], s.cg_ccw_mm[0], s.cg_ccw_mm[1], s.sigma_mm,
-            s.sem_mm, s.avg_abs_theta_err_deg);
+    fprintf(f,
+            "  \"emax_syst_mm\": %.3f,\n  \"cg_cw_mm\": [%.3f, %.3f],\n  \"cg_ccw_mm\": [%.3f, %.3f],\n"
+            "  \"sigma_mm\": %.3f,\n  \"sem_mm\": %.3f,\n  \"avg_abs_theta_err_deg\": %.4f,\n  \"runs\": [\n",
+            s.emax_syst_mm, s.cg_cw_mm[0], s.cg_cw_mm[1], s.cg_ccw_mm[0], s.cg_ccw_mm[1], s.sigma_mm, s.sem_mm,
+            s.avg_abs_theta_err_deg);
     for (size_t i = 0; i < n; ++i) {
-        fprintf(f, "    {\"run\": %u, \"direction\": \"%s\", \"ex_mm\": %.3f, \"ey_mm\": %.3f, \"etheta_deg\": %.4f}%s\n",
+        fprintf(f,
+                "    {\"run\": %u, \"direction\": \"%s\", \"ex_mm\": %.3f, \"ey_mm\": %.3f, \"etheta_deg\": %.4f}%s\n",
                 r[i].run, straight ? "fwd" : (r[i].ccw ? "ccw" : "cw"), r[i].ex_mm, r[i].ey_mm, r[i].etheta_deg,
                 i + 1 < n ? "," : "");
     }
@@ -150,8 +149,7 @@ static int write_summary(odo_out_dir_t *dir, const char *experiment, const char 
 
 int main(int argc, char **argv)
 {
-    const char *experiment = NULL, *vehicle_name = NULL, *scenario_path = NULL, *robot_path = NULL,
-               *out = NULL;
+    const char *experiment = NULL, *vehicle_name = NULL, *scenario_path = NULL, *robot_path = NULL, *out = NULL;
     long runs = 5, bumps = -1;
     int ipec = 0, quiet = 0, seed_given = 0, list_effects = 0, list_json = 0;
     uint64_t seed = 0;
@@ -163,19 +161,42 @@ int main(int argc, char **argv)
                 (unsigned long long)ODO_LOG_START_MAX_S);
         return 2;
     }
-    enum { O_EXPERIMENT = 256, O_VEHICLE, O_SCENARIO, O_ROBOT, O_PARAMS, O_OUT, O_RUNS, O_BUMPS, O_IPEC, O_SEED,
-           O_FORCE, O_QUIET, O_JSON, O_LIST, O_VERSION, O_LOG_START };
-    static const struct option longopts[] = {
-        {"experiment", required_argument, NULL, O_EXPERIMENT}, {"vehicle", required_argument, NULL, O_VEHICLE},
-        {"scenario", required_argument, NULL, O_SCENARIO},     {"robot", required_argument, NULL, O_ROBOT},
-        {"params", required_argument, NULL, O_PARAMS},         {"out", required_argument, NULL, O_OUT},
-        {"runs", required_argument, NULL, O_RUNS},             {"bumps", required_argument, NULL, O_BUMPS},
-        {"ipec", required_argument, NULL, O_IPEC},             {"seed", required_argument, NULL, O_SEED},
-        {"force", no_argument, NULL, O_FORCE},                 {"quiet", no_argument, NULL, O_QUIET},
-        {"json", no_argument, NULL, O_JSON},                   {"list-effects", no_argument, NULL, O_LIST},
-        {"version", no_argument, NULL, O_VERSION},             {"help", no_argument, NULL, 'h'},
-        {"log-start", required_argument, NULL, O_LOG_START},
-        {NULL, 0, NULL, 0}};
+    enum {
+        O_EXPERIMENT = 256,
+        O_VEHICLE,
+        O_SCENARIO,
+        O_ROBOT,
+        O_PARAMS,
+        O_OUT,
+        O_RUNS,
+        O_BUMPS,
+        O_IPEC,
+        O_SEED,
+        O_FORCE,
+        O_QUIET,
+        O_JSON,
+        O_LIST,
+        O_VERSION,
+        O_LOG_START
+    };
+    static const struct option longopts[] = {{"experiment", required_argument, NULL, O_EXPERIMENT},
+                                             {"vehicle", required_argument, NULL, O_VEHICLE},
+                                             {"scenario", required_argument, NULL, O_SCENARIO},
+                                             {"robot", required_argument, NULL, O_ROBOT},
+                                             {"params", required_argument, NULL, O_PARAMS},
+                                             {"out", required_argument, NULL, O_OUT},
+                                             {"runs", required_argument, NULL, O_RUNS},
+                                             {"bumps", required_argument, NULL, O_BUMPS},
+                                             {"ipec", required_argument, NULL, O_IPEC},
+                                             {"seed", required_argument, NULL, O_SEED},
+                                             {"force", no_argument, NULL, O_FORCE},
+                                             {"quiet", no_argument, NULL, O_QUIET},
+                                             {"json", no_argument, NULL, O_JSON},
+                                             {"list-effects", no_argument, NULL, O_LIST},
+                                             {"version", no_argument, NULL, O_VERSION},
+                                             {"help", no_argument, NULL, 'h'},
+                                             {"log-start", required_argument, NULL, O_LOG_START},
+                                             {NULL, 0, NULL, 0}};
     opterr = 1;
     for (int c; (c = getopt_long(argc, argv, "h", longopts, NULL)) != -1;) {
         switch (c) {
@@ -337,9 +358,15 @@ int main(int argc, char **argv)
                 fprintf(rf.truth, "t_s,a_x_mm,a_y_mm,a_theta_deg,b_x_mm,b_y_mm,b_theta_deg,alpha_deg,"
                                   "beta_deg,l_mm,events\n");
                 const sim_run_config_t cfg = {
-                    .robot = &robot, .scenario = &scenario, .experiment = experiment, .ccw = d,
-                    .bumps = (int)bumps, .bump_height_mm = 10.0, .ipec = ipec,
-                    .seed = sim_run_seed(seed, d, k), .run_index = k,
+                    .robot = &robot,
+                    .scenario = &scenario,
+                    .experiment = experiment,
+                    .ccw = d,
+                    .bumps = (int)bumps,
+                    .bump_height_mm = 10.0,
+                    .ipec = ipec,
+                    .seed = sim_run_seed(seed, d, k),
+                    .run_index = k,
                 };
                 if (sim_run(&cfg, on_tick, &rf, &rets[n_ret], err, sizeof err) != 0) {
                     fprintf(stderr, "odo-sim: %s\n", err);
@@ -351,8 +378,7 @@ int main(int argc, char **argv)
                 }
                 n_ret++;
             }
-            if ((rf.log != NULL && fclose(rf.log) != 0) || (rf.truth != NULL && fclose(rf.truth) != 0) ||
-                rf.io_error) {
+            if ((rf.log != NULL && fclose(rf.log) != 0) || (rf.truth != NULL && fclose(rf.truth) != 0) || rf.io_error) {
                 if (rc == 0) {
                     fprintf(stderr, "odo-sim: writing run files failed\n");
                 }

@@ -236,7 +236,7 @@ START_TEST(file_abort_leaves_the_target_and_folders_as_they_were)
     ck_assert_str_eq(get(at("keep.json")), "old\n");
     ck_assert_int_eq(odo_out_file_begin(&o, at("n1/n2/f.json"), NULL, err, sizeof err), 0);
     odo_out_file_abort(&o);
-    odo_out_file_abort(&o); /* twice is fine */
+    odo_out_file_abort(&o);                   /* twice is fine */
     ck_assert_int_eq(count(g_root, NULL), 1); /* the parents made for it are gone too */
 }
 END_TEST
@@ -299,7 +299,8 @@ START_TEST(dir_fresh_is_built_beside_and_renamed_into_place_with_its_manifest)
     char err[512];
     ck_assert_int_eq(write_dir(at("out/run"), "odo-test", false, NULL, k_two, 2, "1\n", err), 0);
     ck_assert_str_eq(get(at("out/run/a.log")), "1\n");
-    ck_assert_str_eq(get(at("out/run/" ODO_OUT_MANIFEST)), ODO_OUT_MANIFEST_MAGIC "\ntool odo-test\na.log\nsummary.json\n");
+    ck_assert_str_eq(get(at("out/run/" ODO_OUT_MANIFEST)),
+                     ODO_OUT_MANIFEST_MAGIC "\ntool odo-test\na.log\nsummary.json\n");
     int temps;
     ck_assert_int_eq(count(at("out"), &temps), 1);
     ck_assert_int_eq(temps, 0);
@@ -353,7 +354,8 @@ START_TEST(dir_rerun_replaces_exactly_its_previous_files)
     ck_assert_str_eq(get(at("o/run-cw-02.log")), "<missing>"); /* ours, no longer written */
     ck_assert_str_eq(get(at("o/sub/r.csv")), "<missing>");
     ck_assert_str_eq(get(at("o/notes.txt")), "user's\n");
-    ck_assert_str_eq(get(at("o/" ODO_OUT_MANIFEST)), ODO_OUT_MANIFEST_MAGIC "\ntool odo-sim\nrun-cw-01.log\nsummary.json\n");
+    ck_assert_str_eq(get(at("o/" ODO_OUT_MANIFEST)),
+                     ODO_OUT_MANIFEST_MAGIC "\ntool odo-sim\nrun-cw-01.log\nsummary.json\n");
     /* Another tool's manifest is foreign. */
     ck_assert_int_eq(write_dir(at("o"), "odo-replay", false, NULL, second, 2, "3\n", err), -1);
     ck_assert_str_eq(get(at("o/summary.json")), "2\n");

@@ -48,13 +48,11 @@ void fake_stm32_can_rx(uint32_t id, bool ext, bool rtr, uint8_t raw_dlc, const u
     m->dhr = (uint32_t)data[4] | ((uint32_t)data[5] << 8) | ((uint32_t)data[6] << 16) | ((uint32_t)data[7] << 24);
 }
 
-#define IN(block, reg) ((const volatile void *)(reg) >= (const volatile void *)&(block) && \
-                        (const volatile void *)(reg) < (const volatile void *)(&(block) + 1))
+#define IN(block, reg)                                                  \
+    ((const volatile void *)(reg) >= (const volatile void *)&(block) && \
+     (const volatile void *)(reg) < (const volatile void *)(&(block) + 1))
 
-static bool pin_low(const odo_stm32_gpio_t *g, uint8_t pin)
-{
-    return (g->ODR & (1UL << pin)) == 0U;
-}
+static bool pin_low(const odo_stm32_gpio_t *g, uint8_t pin) { return (g->ODR & (1UL << pin)) == 0U; }
 
 static int selected_chip(void)
 {

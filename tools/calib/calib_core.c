@@ -22,8 +22,10 @@ int calib_umbmark(const returns_t *r, double side_mm, const odo_params_t *in_for
     }
     for (int d = 0; d < 2; ++d) {
         if (r->n[d] < 2) {
-            snprintf(err, errlen, "%zu %s run%s: UMBmark needs at least 2 runs in each direction (000 s. 3.5 "
-                                  "asks for 5)", r->n[d], d ? "ccw" : "cw", r->n[d] == 1 ? "" : "s");
+            snprintf(err, errlen,
+                     "%zu %s run%s: UMBmark needs at least 2 runs in each direction (000 s. 3.5 "
+                     "asks for 5)",
+                     r->n[d], d ? "ccw" : "cw", r->n[d] == 1 ? "" : "s");
             return -1;
         }
     }

@@ -124,10 +124,14 @@ int calib_fit_main(int argc, char **argv)
         char buf[128];
         snprintf(buf, sizeof buf, "%s", free_list);
         for (char *tok = strtok(buf, ","); tok != NULL; tok = strtok(NULL, ",")) {
-            if (strcmp(tok, "ed") == 0) fr.ed = true;
-            else if (strcmp(tok, "eb") == 0) fr.eb = true;
-            else if (strcmp(tok, "es") == 0) fr.es = true;
-            else if (strcmp(tok, "scrub") == 0) fr.k = true;
+            if (strcmp(tok, "ed") == 0)
+                fr.ed = true;
+            else if (strcmp(tok, "eb") == 0)
+                fr.eb = true;
+            else if (strcmp(tok, "es") == 0)
+                fr.es = true;
+            else if (strcmp(tok, "scrub") == 0)
+                fr.k = true;
             else {
                 fprintf(stderr, "odo-calib fit: --free: unknown parameter '%s' (ed, eb, es, scrub)\n", tok);
                 return 2;
@@ -165,7 +169,8 @@ int calib_fit_main(int argc, char **argv)
     char err[1024];
     static sim_robot_t rob;
     odo_params_t p0;
-    if (sim_robot_parse_file(robot, &rob, err, sizeof err) != 0 || sim_robot_to_params(&rob, &p0, err, sizeof err) != 0) {
+    if (sim_robot_parse_file(robot, &rob, err, sizeof err) != 0 ||
+        sim_robot_to_params(&rob, &p0, err, sizeof err) != 0) {
         fprintf(stderr, "odo-calib fit: %s\n", err);
         return 1;
     }
@@ -276,8 +281,8 @@ int calib_fit_main(int argc, char **argv)
         json_str(stdout, robot);
         printf(",\n \"params\": {\"ed\": %.9f, \"eb\": %.9f, \"es\": %.9f, \"scrub\": %.9f},\n", res.p.ed, res.p.eb,
                res.p.es, res.p.k);
-        printf(" \"sd\": {\"ed\": %.3g, \"eb\": %.3g, \"es\": %.3g, \"scrub\": %.3g},\n", res.sd.ed, res.sd.eb, res.sd.es,
-               res.sd.k);
+        printf(" \"sd\": {\"ed\": %.3g, \"eb\": %.3g, \"es\": %.3g, \"scrub\": %.3g},\n", res.sd.ed, res.sd.eb,
+               res.sd.es, res.sd.k);
         printf(" \"fitted\": {\"ed\": %s, \"eb\": %s, \"es\": %s, \"scrub\": %s},\n", fr.ed ? "true" : "false",
                fr.eb ? "true" : "false", res.es_free ? "true" : "false", res.k_free ? "true" : "false");
         printf(" \"rms_mm\": %.4f, \"residuals\": %zu, \"iterations\": %d,\n \"rig\": {", res.rms_mm, res.n_residuals,
@@ -285,9 +290,8 @@ int calib_fit_main(int argc, char **argv)
         for (size_t g = 0; g < set.n_groups; ++g) {
             printf("%s", g ? ", " : "");
             json_str(stdout, set.group_name[g]);
-            printf(": {\"lever_arm_mm\": [%.3f, %.3f], \"heading_offset_deg\": %.4f, \"fitted\": %s}",
-                   res.rig[g].lx_mm, res.rig[g].ly_mm, res.rig[g].phi_rad * 180.0 / M_PI,
-                   res.rig[g].fitted ? "true" : "false");
+            printf(": {\"lever_arm_mm\": [%.3f, %.3f], \"heading_offset_deg\": %.4f, \"fitted\": %s}", res.rig[g].lx_mm,
+                   res.rig[g].ly_mm, res.rig[g].phi_rad * 180.0 / M_PI, res.rig[g].fitted ? "true" : "false");
         }
         printf("},\n \"runs\": [");
         for (size_t i = 0; i < set.n_runs; ++i) {
@@ -336,7 +340,8 @@ int calib_fit_main(int argc, char **argv)
         printf("  Ed    %.6f  (formal sd %.1e)%s\n", res.p.ed, res.sd.ed, fr.ed ? "" : "  fixed");
         printf("  Eb    %.6f  (formal sd %.1e)%s\n", res.p.eb, res.sd.eb, fr.eb ? "" : "  fixed");
         printf("  Es    %.6f  (formal sd %.1e)%s\n", res.p.es, res.sd.es,
-               res.es_free ? "" : (fr.es ? "  fixed: no fitted track (closed paths do not show the scale)" : "  fixed"));
+               res.es_free ? ""
+                           : (fr.es ? "  fixed: no fitted track (closed paths do not show the scale)" : "  fixed"));
         printf("  scrub %.6f  (formal sd %.1e)%s\n", res.p.k, res.sd.k, res.k_free ? "" : "  fixed");
         for (size_t g = 0; g < set.n_groups; ++g) {
             if (res.rig[g].fitted) {
@@ -369,7 +374,8 @@ int calib_fit_main(int argc, char **argv)
             }
         }
         printf("\nfirmware replaying the written block vs the double model of it, every tick of every run: "
-               "max %.2e mm (target <= 0.1 mm)\n", fw_max);
+               "max %.2e mm (target <= 0.1 mm)\n",
+               fw_max);
         if (set.can_fd_skipped) {
             printf("CAN FD lines skipped in the logs: %llu\n", (unsigned long long)set.can_fd_skipped);
         }

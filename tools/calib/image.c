@@ -63,8 +63,8 @@ static cand_t classify(const uint8_t *b, size_t avail)
 
 /// Find the one good block among the magic's occurrences in buf (valid: NULL or a per-byte mask).
 /// Returns 0 with *off, or -1 with a message naming offsets as base + offset.
-static int locate(const uint8_t *buf, size_t len, const uint8_t *valid, uint64_t base, const char *what,
-                  size_t *off, char *err, size_t errlen)
+static int locate(const uint8_t *buf, size_t len, const uint8_t *valid, uint64_t base, const char *what, size_t *off,
+                  char *err, size_t errlen)
 {
     size_t n_cand = 0, n_good = 0, good = 0, n_other = 0, other = 0, n_bad_crc = 0, bad_crc = 0;
     int truncated = 0;
@@ -105,8 +105,7 @@ static int locate(const uint8_t *buf, size_t len, const uint8_t *valid, uint64_t
             truncated = 1;
             trunc_at = i;
             break;
-        case CAND_NOISE:
-            break;
+        case CAND_NOISE: break;
         }
     }
     if (n_good == 1) {
@@ -120,22 +119,28 @@ static int locate(const uint8_t *buf, size_t len, const uint8_t *valid, uint64_t
     if (n_other > 0) {
         /* A block with a good CRC whose header this tool does not accept: another layout. */
         const uint8_t *b = buf + other;
-        snprintf(err, errlen, "%s: parameter block at 0x%llx has layout version %u, length %u; this tool "
-                              "reads %s: refusing to touch it", what, (unsigned long long)(base + other),
-                 (unsigned)rd_le(b + 4, 2), (unsigned)rd_le(b + 6, 2), known_layouts());
+        snprintf(err, errlen,
+                 "%s: parameter block at 0x%llx has layout version %u, length %u; this tool "
+                 "reads %s: refusing to touch it",
+                 what, (unsigned long long)(base + other), (unsigned)rd_le(b + 4, 2), (unsigned)rd_le(b + 6, 2),
+                 known_layouts());
         return -1;
     }
     if (truncated) {
-        snprintf(err, errlen, "%s: truncated: the parameter block starting at 0x%llx is cut off before its "
-                              "declared length", what, (unsigned long long)(base + trunc_at));
+        snprintf(err, errlen,
+                 "%s: truncated: the parameter block starting at 0x%llx is cut off before its "
+                 "declared length",
+                 what, (unsigned long long)(base + trunc_at));
         return -1;
     }
     if (n_bad_crc == 1) {
         *off = bad_crc; /* the only block there is, damaged: the caller decides (write --force) */
         return 0;
     }
-    snprintf(err, errlen, "%s: no parameter block found (%zu 'ODOP' candidates, none with a valid header and "
-                          "CRC-32)", what, n_cand);
+    snprintf(err, errlen,
+             "%s: no parameter block found (%zu 'ODOP' candidates, none with a valid header and "
+             "CRC-32)",
+             what, n_cand);
     return -1;
 }
 
@@ -144,7 +149,8 @@ static int load_elf(img_t *img, const char *path, char *err, size_t errlen)
     const uint8_t *b = img->file;
     const size_t n = img->file_len;
     if (n < 16 || (b[4] != 1 && b[4] != 2) || b[5] != 1) {
-        snprintf(err, errlen, "%s: %s", path, n < 16 ? "truncated ELF header" : "only little-endian ELF32/ELF64 is supported");
+        snprintf(err, errlen, "%s: %s", path,
+                 n < 16 ? "truncated ELF header" : "only little-endian ELF32/ELF64 is supported");
         return -1;
     }
     const int is64 = b[4] == 2;
@@ -165,8 +171,8 @@ static int load_elf(img_t *img, const char *path, char *err, size_t errlen)
         snprintf(err, errlen, "%s: truncated ELF: section headers end beyond the file (%zu bytes)", path, n);
         return -1;
     }
-#define SH(i) (b + shoff + (uint64_t)(i) * shentsize)
-#define SH_OFF(s) (is64 ? rd_le((s) + 24, 8) : rd_le((s) + 16, 4))
+#define SH(i)      (b + shoff + (uint64_t)(i)*shentsize)
+#define SH_OFF(s)  (is64 ? rd_le((s) + 24, 8) : rd_le((s) + 16, 4))
 #define SH_SIZE(s) (is64 ? rd_le((s) + 32, 8) : rd_le((s) + 20, 4))
 #define SH_ADDR(s) (is64 ? rd_le((s) + 16, 8) : rd_le((s) + 12, 4))
     const uint8_t *strsh = SH(shstrndx);
@@ -197,8 +203,10 @@ static int load_elf(img_t *img, const char *path, char *err, size_t errlen)
             return -1;
         }
         if (off > n || ODO_PARAMS_HEADER_SIZE > n - off) {
-            snprintf(err, errlen, "%s: truncated ELF: section .odo_params (offset %llu) lies beyond the end of "
-                                  "the file (%zu bytes)", path, (unsigned long long)off, n);
+            snprintf(err, errlen,
+                     "%s: truncated ELF: section .odo_params (offset %llu) lies beyond the end of "
+                     "the file (%zu bytes)",
+                     path, (unsigned long long)off, n);
             return -1;
         }
         img->block_file_off = (size_t)off;
@@ -220,8 +228,10 @@ static int load_elf(img_t *img, const char *path, char *err, size_t errlen)
             return -1;
         }
         if (want > n - off) {
-            snprintf(err, errlen, "%s: truncated ELF: section .odo_params (offset %llu) lies beyond the end of "
-                                  "the file (%zu bytes)", path, (unsigned long long)off, n);
+            snprintf(err, errlen,
+                     "%s: truncated ELF: section .odo_params (offset %llu) lies beyond the end of "
+                     "the file (%zu bytes)",
+                     path, (unsigned long long)off, n);
             return -1;
         }
         img->block_len = want;
@@ -237,9 +247,12 @@ static int load_elf(img_t *img, const char *path, char *err, size_t errlen)
 
 static int hexval(int c)
 {
-    if (c >= '0' && c <= '9') return c - '0';
-    if (c >= 'A' && c <= 'F') return c - 'A' + 10;
-    if (c >= 'a' && c <= 'f') return c - 'a' + 10;
+    if (c >= '0' && c <= '9')
+        return c - '0';
+    if (c >= 'A' && c <= 'F')
+        return c - 'A' + 10;
+    if (c >= 'a' && c <= 'f')
+        return c - 'a' + 10;
     return -1;
 }
 
@@ -301,8 +314,8 @@ static int load_hex(img_t *img, const char *path, uint8_t **flat_out, uint8_t **
             }
             const unsigned ll = rec[0], type = rec[3];
             if (nb != ll + 5U) {
-                snprintf(err, errlen, "%s:%u: record length %u does not match its %zu data bytes (truncated?)",
-                         path, lineno, ll, nb >= 5 ? nb - 5 : 0);
+                snprintf(err, errlen, "%s:%u: record length %u does not match its %zu data bytes (truncated?)", path,
+                         lineno, ll, nb >= 5 ? nb - 5 : 0);
                 return -1;
             }
             if ((sum & 0xFFU) != 0U) {
@@ -336,9 +349,7 @@ static int load_hex(img_t *img, const char *path, uint8_t **flat_out, uint8_t **
             case 0x04: upper = (((uint64_t)rec[4] << 8) | rec[5]) << 16; break;
             case 0x03:
             case 0x05: break;
-            default:
-                snprintf(err, errlen, "%s:%u: unknown record type %02X", path, lineno, type);
-                return -1;
+            default: snprintf(err, errlen, "%s:%u: unknown record type %02X", path, lineno, type); return -1;
             }
         }
         i = e + 1;
@@ -396,8 +407,8 @@ int img_load(const char *path, img_t *img, char *err, size_t errlen)
     img->mode = (unsigned)(sb.st_mode & 07777);
     /* As large as the file says it is (+1 to see it grew), not the 64 MiB cap every time: the
      * fuzz campaign ran at 5 loads a second with the cap allocated under ASan. */
-    const size_t cap = (sb.st_size < 0 || (uint64_t)sb.st_size >= MAX_IMAGE_BYTES) ? MAX_IMAGE_BYTES + 1
-                                                                                   : (size_t)sb.st_size + 1U;
+    const size_t cap =
+        (sb.st_size < 0 || (uint64_t)sb.st_size >= MAX_IMAGE_BYTES) ? MAX_IMAGE_BYTES + 1 : (size_t)sb.st_size + 1U;
     img->file = malloc(cap);
     if (img->file == NULL) {
         fclose(f);
@@ -418,7 +429,10 @@ int img_load(const char *path, img_t *img, char *err, size_t errlen)
         k++;
     }
     int rc;
-    if (img->file_len >= 4 && memcmp(b, "\x7f" "ELF", 4) == 0) {
+    if (img->file_len >= 4 && memcmp(b,
+                                     "\x7f"
+                                     "ELF",
+                                     4) == 0) {
         img->fmt = IMG_ELF;
         rc = load_elf(img, path, err, errlen);
         if (rc == 0) {
@@ -476,14 +490,14 @@ static void put_hex(uint8_t *p, unsigned v)
 }
 
 int img_write_patched(const img_t *img, const uint8_t block[ODO_PARAMS_SIZE], const char *out_path,
-                      const odo_out_inputs_t *ins, char *err,
-                      size_t errlen)
+                      const odo_out_inputs_t *ins, char *err, size_t errlen)
 {
     if (img->block_len != ODO_PARAMS_SIZE) {
         /* The firmware in the image reads its own layout only, and has room for that many bytes. */
-        snprintf(err, errlen, "the image holds a version-%u parameter block (%zu bytes): its firmware reads that "
-                              "layout only, and this tool writes version %u (%u bytes); rebuild the image with a "
-                              "firmware that reads version %u, or write it with the odo-calib of its own release",
+        snprintf(err, errlen,
+                 "the image holds a version-%u parameter block (%zu bytes): its firmware reads that "
+                 "layout only, and this tool writes version %u (%u bytes); rebuild the image with a "
+                 "firmware that reads version %u, or write it with the odo-calib of its own release",
                  img->version, img->block_len, ODO_PARAMS_VERSION, ODO_PARAMS_SIZE, ODO_PARAMS_VERSION);
         return -1;
     }

@@ -29,25 +29,25 @@
 typedef enum { IMG_BIN = 0, IMG_HEX = 1, IMG_ELF = 2 } img_format_t;
 
 typedef struct {
-    size_t   line_start;  ///< offset of the record's ':' in the file
-    uint64_t addr;        ///< absolute address of its first data byte
+    size_t line_start; ///< offset of the record's ':' in the file
+    uint64_t addr;     ///< absolute address of its first data byte
     unsigned len;
 } img_hex_rec_t;
 
 typedef struct {
-    img_format_t   fmt;
-    uint8_t       *file;       ///< the file's bytes
-    size_t         file_len;
-    uint64_t       block_addr; ///< ELF/HEX: address; BIN: file offset
-    size_t         block_file_off; ///< BIN/ELF: file offset of the block
-    uint8_t        block[ODO_PARAMS_SIZE]; ///< the block found: block_len bytes, zeros after
-    size_t         block_len;  ///< its declared size: ODO_PARAMS_V1_SIZE or ODO_PARAMS_SIZE
-    unsigned       version;    ///< its layout version (1 or 2)
-    odo_params_status_t status; ///< odo_params_decode of the block found
-    unsigned       mode;       ///< the file's permission bits
+    img_format_t fmt;
+    uint8_t *file; ///< the file's bytes
+    size_t file_len;
+    uint64_t block_addr;            ///< ELF/HEX: address; BIN: file offset
+    size_t block_file_off;          ///< BIN/ELF: file offset of the block
+    uint8_t block[ODO_PARAMS_SIZE]; ///< the block found: block_len bytes, zeros after
+    size_t block_len;               ///< its declared size: ODO_PARAMS_V1_SIZE or ODO_PARAMS_SIZE
+    unsigned version;               ///< its layout version (1 or 2)
+    odo_params_status_t status;     ///< odo_params_decode of the block found
+    unsigned mode;                  ///< the file's permission bits
     /* HEX only */
     img_hex_rec_t *rec;
-    size_t         n_rec;
+    size_t n_rec;
 } img_t;
 
 /// Read and locate the block. Returns 0 with *img filled (img->status says whether the block

@@ -36,30 +36,29 @@ static const char *const k_prog = "odo-calib";
 
 static void usage(FILE *f)
 {
-    fprintf(f,
-            "usage: odo-calib <command> [options]      (odo-calib <command> --help for details)\n"
-            "       odo-calib --help | --version\n"
-            "\n"
-            "  umbmark --returns returns.csv --side-mm 4000 (--robot R.json | --params P.json|P.bin)\n"
-            "          [--robot R.json --params P] [--method paper|exact] [--json] [--out-params P.json|P.bin]\n"
-            "      UMBmark calibration (000 s. 6) of truck A from the return errors (000 Eq. 3.1);\n"
-            "      --params: the block the robot ran the test with (default: from --robot).\n"
-            "  write --image FW --params P.json|P.bin [--out OUT] [--force]\n"
-            "      put the parameter block into a firmware image (raw .bin, Intel HEX or ELF\n"
-            "      .odo_params); CRC recomputed; in place unless --out.\n"
-            "  read --image FW [--json]     print the image's parameter block (version 1 or 2)\n"
-            "  verify --image FW            check the image's block (layout, version, CRC, ranges)\n"
-            "  export --params P.json|P.bin --format ros2 [--controller-name NAME]\n"
-            "      diff_drive_controller parameters (YAML): absolute values and multipliers\n"
-            "  fit --runs DIR... --robot R.json [--fit GLOB...] [--judge GLOB...] [--out-params P]... [--json]\n"
-            "      calibrate Ed, Eb, Es and the turn-radius-dependent wheelbase from runs on any path\n"
-            "      with a truth track or return poses (odo-import folders); held-out before/after.\n"
-            "  acceptance [--robots N] [--seed S] [--runs N] [--json] [--no-tape] [--quiet]\n"
-            "      simulated labmates (Ed ~ U[0.995, 1.005], b ~ U[0.97, 1.03] x 340 mm, floor\n"
-            "      roughness): Emax,syst before/after one pass, exact and paper methods; E-7/E-8\n"
-            "      tape analogues; noise-free recovery. Prints a 000 Table III-like table.\n"
-            "\n"
-            "Exit status: 0 ok, 1 rejected input or I/O error, 2 usage error.\n");
+    fprintf(f, "usage: odo-calib <command> [options]      (odo-calib <command> --help for details)\n"
+               "       odo-calib --help | --version\n"
+               "\n"
+               "  umbmark --returns returns.csv --side-mm 4000 (--robot R.json | --params P.json|P.bin)\n"
+               "          [--robot R.json --params P] [--method paper|exact] [--json] [--out-params P.json|P.bin]\n"
+               "      UMBmark calibration (000 s. 6) of truck A from the return errors (000 Eq. 3.1);\n"
+               "      --params: the block the robot ran the test with (default: from --robot).\n"
+               "  write --image FW --params P.json|P.bin [--out OUT] [--force]\n"
+               "      put the parameter block into a firmware image (raw .bin, Intel HEX or ELF\n"
+               "      .odo_params); CRC recomputed; in place unless --out.\n"
+               "  read --image FW [--json]     print the image's parameter block (version 1 or 2)\n"
+               "  verify --image FW            check the image's block (layout, version, CRC, ranges)\n"
+               "  export --params P.json|P.bin --format ros2 [--controller-name NAME]\n"
+               "      diff_drive_controller parameters (YAML): absolute values and multipliers\n"
+               "  fit --runs DIR... --robot R.json [--fit GLOB...] [--judge GLOB...] [--out-params P]... [--json]\n"
+               "      calibrate Ed, Eb, Es and the turn-radius-dependent wheelbase from runs on any path\n"
+               "      with a truth track or return poses (odo-import folders); held-out before/after.\n"
+               "  acceptance [--robots N] [--seed S] [--runs N] [--json] [--no-tape] [--quiet]\n"
+               "      simulated labmates (Ed ~ U[0.995, 1.005], b ~ U[0.97, 1.03] x 340 mm, floor\n"
+               "      roughness): Emax,syst before/after one pass, exact and paper methods; E-7/E-8\n"
+               "      tape analogues; noise-free recovery. Prints a 000 Table III-like table.\n"
+               "\n"
+               "Exit status: 0 ok, 1 rejected input or I/O error, 2 usage error.\n");
 }
 
 static int is_help(const char *a) { return strcmp(a, "-h") == 0 || strcmp(a, "--help") == 0; }
@@ -67,7 +66,7 @@ static int is_help(const char *a) { return strcmp(a, "-h") == 0 || strcmp(a, "--
 /// Options as name/value pairs; flags have value "1".
 typedef struct {
     const char *name;
-    int         takes_value;
+    int takes_value;
     const char *value;
 } opt_t;
 
@@ -96,8 +95,8 @@ static int parse_opts(const char *cmd, int argc, char **argv, opt_t *o, size_t n
         o[c].value = o[c].takes_value ? optarg : "1";
     }
     if (optind < argc + 1) {
-        fprintf(stderr, "%s %s: unexpected argument '%s' (see %s %s --help)\n", k_prog, cmd, argv[optind - 1],
-                k_prog, cmd);
+        fprintf(stderr, "%s %s: unexpected argument '%s' (see %s %s --help)\n", k_prog, cmd, argv[optind - 1], k_prog,
+                cmd);
         return -1;
     }
     return 0;
@@ -160,36 +159,43 @@ static void print_calib_json(FILE *f, const calib_result_t *c, const char *retur
 {
     const odo_umb_stats_t *s = &c->st;
     const odo_umb_calib_t *p = &c->paper;
-    fprintf(f, "{\"method\": \"%s\", \"returns\": \"%s\", \"side_mm\": %.3f,\n", c->method == CALIB_EXACT ? "exact" : "paper",
-            returns_path, side_mm);
+    fprintf(f, "{\"method\": \"%s\", \"returns\": \"%s\", \"side_mm\": %.3f,\n",
+            c->method == CALIB_EXACT ? "exact" : "paper", returns_path, side_mm);
     fprintf(f, " \"Ed\": %.9f, \"Eb\": %.9f, \"cL\": %.9f, \"cR\": %.9f, \"b_actual_mm\": %.4f,\n", c->ed_q30 / Q30,
             c->eb_q30 / Q30, c->cl_q30 / Q30, c->cr_q30 / Q30, c->b_actual_mm);
     fprintf(f, " \"ed_q30\": %" PRId32 ", \"eb_q30\": %" PRId32 ", \"ed_in_force\": %.9f, \"eb_in_force\": %.9f,\n",
             c->ed_q30, c->eb_q30, c->ed_in_force, c->eb_in_force);
-    fprintf(f, " \"alpha_deg\": %.6f, \"beta_deg\": %.6f, \"alpha_x_deg\": %.6f, \"alpha_y_deg\": %.6f, "
-               "\"beta_x_deg\": %.6f, \"beta_y_deg\": %.6f,\n \"alpha_disagree_deg\": %.6f, \"beta_disagree_deg\": %.6f, "
-               "\"radius_mm\": %.1f,\n",
+    fprintf(f,
+            " \"alpha_deg\": %.6f, \"beta_deg\": %.6f, \"alpha_x_deg\": %.6f, \"alpha_y_deg\": %.6f, "
+            "\"beta_x_deg\": %.6f, \"beta_y_deg\": %.6f,\n \"alpha_disagree_deg\": %.6f, \"beta_disagree_deg\": %.6f, "
+            "\"radius_mm\": %.1f,\n",
             p->alpha_bam * BAM_DEG, p->beta_bam * BAM_DEG, p->alpha_x_bam * BAM_DEG, p->alpha_y_bam * BAM_DEG,
             p->beta_x_bam * BAM_DEG, p->beta_y_bam * BAM_DEG, p->alpha_disagree_bam * BAM_DEG,
             p->beta_disagree_bam * BAM_DEG, (double)p->radius_um / 1000.0);
-    fprintf(f, " \"runs_cw\": %u, \"runs_ccw\": %u, \"cg_cw_mm\": [%.3f, %.3f], \"cg_ccw_mm\": [%.3f, %.3f], "
-               "\"r_cg_cw_mm\": %.3f, \"r_cg_ccw_mm\": %.3f,\n",
+    fprintf(f,
+            " \"runs_cw\": %u, \"runs_ccw\": %u, \"cg_cw_mm\": [%.3f, %.3f], \"cg_ccw_mm\": [%.3f, %.3f], "
+            "\"r_cg_cw_mm\": %.3f, \"r_cg_ccw_mm\": %.3f,\n",
             s->n[0], s->n[1], s->cg_x_um[0] / 1000.0, s->cg_y_um[0] / 1000.0, s->cg_x_um[1] / 1000.0,
             s->cg_y_um[1] / 1000.0, s->r_cg_um[0] / 1000.0, s->r_cg_um[1] / 1000.0);
     fprintf(f, " \"emax_syst_mm\": %.3f, \"sigma_mm\": %.3f, \"sem_mm\": %.3f, \"second_pass_advised\": %s,\n",
-            s->emax_syst_um / 1000.0, s->sigma_um / 1000.0, s->sem_um / 1000.0, s->second_pass_advised ? "true" : "false");
+            s->emax_syst_um / 1000.0, s->sigma_um / 1000.0, s->sem_um / 1000.0,
+            s->second_pass_advised ? "true" : "false");
     fprintf(f, " \"theta_bias_cw_deg\": %.6f, \"theta_bias_ccw_deg\": %.6f, \"avg_abs_theta_deg\": %.6f,\n",
             s->theta_bias_udeg[0] / 1e6, s->theta_bias_udeg[1] / 1e6, s->avg_abs_theta_udeg / 1e6);
-    fprintf(f, " \"paper\": {\"Ed\": %.9f, \"Eb\": %.9f, \"b_actual_mm\": %.4f, \"ed_measured\": %.9f, \"eb_measured\": %.9f},\n",
-            p->ed_q30 / Q30, p->eb_q30 / Q30, p->b_actual_nm / 1e6, p->ed_meas_q30 / Q30, p->eb_meas_q30 / Q30);
+    fprintf(
+        f,
+        " \"paper\": {\"Ed\": %.9f, \"Eb\": %.9f, \"b_actual_mm\": %.4f, \"ed_measured\": %.9f, \"eb_measured\": %.9f},\n",
+        p->ed_q30 / Q30, p->eb_q30 / Q30, p->b_actual_nm / 1e6, p->ed_meas_q30 / Q30, p->eb_meas_q30 / Q30);
     if (c->method == CALIB_EXACT) {
-        fprintf(f, " \"exact\": {\"Ed\": %.9f, \"b_mm\": %.5f, \"residual_mm\": %.4f, \"iterations\": %d, "
-                   "\"converged\": %s, \"identifiable\": %s, \"singular_value_ratio\": %.3e},\n",
+        fprintf(f,
+                " \"exact\": {\"Ed\": %.9f, \"b_mm\": %.5f, \"residual_mm\": %.4f, \"iterations\": %d, "
+                "\"converged\": %s, \"identifiable\": %s, \"singular_value_ratio\": %.3e},\n",
                 c->fit.ed, c->fit.b_mm, c->fit.residual_mm, c->fit.iterations, c->fit.converged ? "true" : "false",
                 c->fit.identifiable ? "true" : "false", c->fit.sv_max > 0 ? c->fit.sv_min / c->fit.sv_max : 0.0);
     }
-    fprintf(f, " \"not_identifiable\": [\"es: a closed square does not show the scale error; measure it with a tape "
-               "(000 App. B)\", \"truck B: UMBmark returns are truck A's\"%s],\n",
+    fprintf(f,
+            " \"not_identifiable\": [\"es: a closed square does not show the scale error; measure it with a tape "
+            "(000 App. B)\", \"truck B: UMBmark returns are truck A's\"%s],\n",
             c->method == CALIB_EXACT && !c->fit.identifiable ? ", \"Ed and b: the data do not separate them\"" : "");
     fprintf(f, " \"out_params\": ");
     if (out_params != NULL) {
@@ -206,10 +212,11 @@ static void print_calib_table(FILE *f, const calib_result_t *c)
     fprintf(f, "UMBmark (000 s. 3): %u cw + %u ccw runs\n", s->n[0], s->n[1]);
     fprintf(f, "  cg cw  (%9.2f, %9.2f) mm   r %8.2f mm   (Eqs. 3.2, 3.3)\n", s->cg_x_um[0] / 1e3, s->cg_y_um[0] / 1e3,
             s->r_cg_um[0] / 1e3);
-    fprintf(f, "  cg ccw (%9.2f, %9.2f) mm   r %8.2f mm\n", s->cg_x_um[1] / 1e3, s->cg_y_um[1] / 1e3, s->r_cg_um[1] / 1e3);
+    fprintf(f, "  cg ccw (%9.2f, %9.2f) mm   r %8.2f mm\n", s->cg_x_um[1] / 1e3, s->cg_y_um[1] / 1e3,
+            s->r_cg_um[1] / 1e3);
     fprintf(f, "  Emax,syst %.2f mm (Eq. 3.4)   sigma %.2f mm   SEM %.2f mm   second pass %s (Emax,syst %s 3 SEM)\n",
-            s->emax_syst_um / 1e3, s->sigma_um / 1e3, s->sem_um / 1e3, s->second_pass_advised ? "advised" : "not needed",
-            s->second_pass_advised ? ">" : "<=");
+            s->emax_syst_um / 1e3, s->sigma_um / 1e3, s->sem_um / 1e3,
+            s->second_pass_advised ? "advised" : "not needed", s->second_pass_advised ? ">" : "<=");
     fprintf(f, "  alpha %.4f deg (x %.4f, y %.4f)   beta %.4f deg (x %.4f, y %.4f)   (Eqs. 6.22, 6.26)\n",
             p->alpha_bam * BAM_DEG, p->alpha_x_bam * BAM_DEG, p->alpha_y_bam * BAM_DEG, p->beta_bam * BAM_DEG,
             p->beta_x_bam * BAM_DEG, p->beta_y_bam * BAM_DEG);
@@ -246,8 +253,8 @@ static int params_in_force(const char *cmd, const char *robot_path, const char *
 
 static int cmd_umbmark(int argc, char **argv)
 {
-    opt_t o[] = {{"--returns", 1, NULL}, {"--side-mm", 1, NULL}, {"--robot", 1, NULL}, {"--params", 1, NULL},
-                 {"--method", 1, NULL}, {"--json", 0, NULL}, {"--out-params", 1, NULL}};
+    opt_t o[] = {{"--returns", 1, NULL}, {"--side-mm", 1, NULL}, {"--robot", 1, NULL},     {"--params", 1, NULL},
+                 {"--method", 1, NULL},  {"--json", 0, NULL},    {"--out-params", 1, NULL}};
     const size_t n = sizeof o / sizeof o[0];
     for (int i = 0; i < argc; ++i) {
         if (is_help(argv[i])) {
@@ -380,8 +387,10 @@ static int cmd_write(int argc, char **argv)
         return EXIT_FAIL;
     }
     if (img.status == ODO_PARAMS_ERR_CRC && opt(o, n, "--force") == NULL) {
-        fprintf(stderr, "%s write: %s: the block at 0x%llx has a bad CRC-32 (corrupted image?); --force to "
-                        "overwrite it anyway\n", k_prog, image, (unsigned long long)img.block_addr);
+        fprintf(stderr,
+                "%s write: %s: the block at 0x%llx has a bad CRC-32 (corrupted image?); --force to "
+                "overwrite it anyway\n",
+                k_prog, image, (unsigned long long)img.block_addr);
         img_free(&img);
         return EXIT_FAIL;
     }
@@ -448,9 +457,10 @@ static uint32_t stored_crc(const img_t *img)
 
 static int cmd_read(int argc, char **argv)
 {
-    if (help_if(argc, argv, "usage: odo-calib read --image FW [--json]\n\nPrint the parameter block of a firmware "
-                            "image (.bin, Intel HEX, ELF), version 1 or 2; --json in the shape `odo-params show` "
-                            "prints (a version-1 block without scrub_q30).\n")) {
+    if (help_if(argc, argv,
+                "usage: odo-calib read --image FW [--json]\n\nPrint the parameter block of a firmware "
+                "image (.bin, Intel HEX, ELF), version 1 or 2; --json in the shape `odo-params show` "
+                "prints (a version-1 block without scrub_q30).\n")) {
         return 0;
     }
     img_t img;
@@ -474,14 +484,15 @@ static int cmd_read(int argc, char **argv)
             int32_t cl_q = 0, cr_q = 0;
             (void)odo_umb_correction_factors(t->ed_q30, &cl_q, &cr_q);
             printf("truck %c: Dn %.4f mm, b %.4f mm, counts/rev %.3f, Ed %.7f, Eb %.7f, Es %.7f, scrub k %.7f "
-                   "(cL %.7f, cR %.7f, b_actual %.4f mm on spot turns)\n", 'A' + k, t->wheel_diameter_nm / 1e6,
-                   t->wheelbase_nm / 1e6, t->counts_per_rev_milli / 1e3, t->ed_q30 / Q30, t->eb_q30 / Q30,
-                   t->es_q30 / Q30, t->scrub_q30 / Q30, cl_q / Q30, cr_q / Q30,
+                   "(cL %.7f, cR %.7f, b_actual %.4f mm on spot turns)\n",
+                   'A' + k, t->wheel_diameter_nm / 1e6, t->wheelbase_nm / 1e6, t->counts_per_rev_milli / 1e3,
+                   t->ed_q30 / Q30, t->eb_q30 / Q30, t->es_q30 / Q30, t->scrub_q30 / Q30, cl_q / Q30, cr_q / Q30,
                    t->wheelbase_nm / 1e6 * (t->eb_q30 / Q30));
         }
         if (img.version < ODO_PARAMS_VERSION) {
             printf("(a version-%u block: scrub_q30 reads as 0; `odo-calib write` refuses this image, whose firmware "
-                   "reads version %u only)\n", img.version, img.version);
+                   "reads version %u only)\n",
+                   img.version, img.version);
         }
     }
     img_free(&img);
@@ -490,10 +501,11 @@ static int cmd_read(int argc, char **argv)
 
 static int cmd_verify(int argc, char **argv)
 {
-    if (help_if(argc, argv, "usage: odo-calib verify --image FW\n\nCheck the parameter block of a firmware image as "
-                            "the firmware does at boot (magic, version 1 or 2, length, CRC-32, every range, reserved "
-                            "bytes zero). Exit 0 iff the firmware would accept it; otherwise the message names the "
-                            "offending field.\n")) {
+    if (help_if(argc, argv,
+                "usage: odo-calib verify --image FW\n\nCheck the parameter block of a firmware image as "
+                "the firmware does at boot (magic, version 1 or 2, length, CRC-32, every range, reserved "
+                "bytes zero). Exit 0 iff the firmware would accept it; otherwise the message names the "
+                "offending field.\n")) {
         return 0;
     }
     img_t img;
@@ -537,7 +549,8 @@ static int cmd_export(int argc, char **argv)
         return EXIT_USAGE;
     }
     const char *params = opt(o, n, "--params"), *format = opt(o, n, "--format");
-    const char *name = opt(o, n, "--controller-name") != NULL ? opt(o, n, "--controller-name") : "diff_drive_controller";
+    const char *name =
+        opt(o, n, "--controller-name") != NULL ? opt(o, n, "--controller-name") : "diff_drive_controller";
     if (params == NULL || format == NULL) {
         fprintf(stderr, "%s export: --params and --format are required\n", k_prog);
         return EXIT_USAGE;
@@ -552,8 +565,8 @@ static int cmd_export(int argc, char **argv)
         name_ok = (*c >= 'a' && *c <= 'z') || (*c >= 'A' && *c <= 'Z') || (*c >= '0' && *c <= '9') || *c == '_';
     }
     if (!name_ok) {
-        fprintf(stderr, "%s export: --controller-name '%s' is not a ROS 2 node name ([A-Za-z_][A-Za-z0-9_]*)\n",
-                k_prog, name);
+        fprintf(stderr, "%s export: --controller-name '%s' is not a ROS 2 node name ([A-Za-z_][A-Za-z0-9_]*)\n", k_prog,
+                name);
         return EXIT_USAGE;
     }
     odo_params_t p;

@@ -41,12 +41,10 @@ int main(int argc, char **argv)
     int ccw = 0;
     bool force = false;
     enum { O_OUT = 256, O_DIRECTION, O_FORCE, O_VERSION };
-    static const struct option longopts[] = {{"out", required_argument, NULL, O_OUT},
-                                              {"direction", required_argument, NULL, O_DIRECTION},
-                                              {"force", no_argument, NULL, O_FORCE},
-                                              {"version", no_argument, NULL, O_VERSION},
-                                              {"help", no_argument, NULL, 'h'},
-                                              {NULL, 0, NULL, 0}};
+    static const struct option longopts[] = {
+        {"out", required_argument, NULL, O_OUT}, {"direction", required_argument, NULL, O_DIRECTION},
+        {"force", no_argument, NULL, O_FORCE},   {"version", no_argument, NULL, O_VERSION},
+        {"help", no_argument, NULL, 'h'},        {NULL, 0, NULL, 0}};
     for (int c; (c = getopt_long(argc, argv, "h", longopts, NULL)) != -1;) {
         switch (c) {
         case 'h': usage(stdout); return 0;
@@ -146,17 +144,18 @@ int main(int argc, char **argv)
             cr += dr;
             odo_ref_step(&real, dl, dr);
             hal.now_us = t_us;
-            hal_test_set_wheel(&hal, 0U, (uint32_t)((uint64_t)cl & 0xFFFFFFU),
-                               (uint32_t)((uint64_t)cr & 0xFFFFFFU), 24U, seq++);
+            hal_test_set_wheel(&hal, 0U, (uint32_t)((uint64_t)cl & 0xFFFFFFU), (uint32_t)((uint64_t)cr & 0xFFFFFFU),
+                               24U, seq++);
             hal.n_tx = 0U;
             odo_loop_tick(&app, &hal, &loop_in, &out);
             for (uint32_t f = 0U; f < hal.n_tx; ++f) {
                 odo_candump_write(lf, t_us, "vcan0", &hal.tx[f]);
             }
             const odo_pose_t *pose = &out.pose[0];
-            fprintf(pf, "%.3f,%.4f,%.4f,%.6f,%.4f,%.4f,%.6f\n", (double)t_us * 1e-6, (double)pose->x_mm_q32 / 4294967296.0,
-                    (double)pose->y_mm_q32 / 4294967296.0, (double)(int32_t)odo_heading_bam(pose) * (360.0 / 4294967296.0),
-                    real.x_mm, real.y_mm, real.theta_rad * 180.0 / M_PI);
+            fprintf(pf, "%.3f,%.4f,%.4f,%.6f,%.4f,%.4f,%.6f\n", (double)t_us * 1e-6,
+                    (double)pose->x_mm_q32 / 4294967296.0, (double)pose->y_mm_q32 / 4294967296.0,
+                    (double)(int32_t)odo_heading_bam(pose) * (360.0 / 4294967296.0), real.x_mm, real.y_mm,
+                    real.theta_rad * 180.0 / M_PI);
             t_us += p.tick_us;
         }
     }
@@ -174,8 +173,7 @@ int main(int argc, char **argv)
     const odo_pose_t *pose = &out.pose[0];
     const double xc = (double)pose->x_mm_q32 / 4294967296.0, yc = (double)pose->y_mm_q32 / 4294967296.0;
     const double thc = (double)(int32_t)odo_heading_bam(pose) * (360.0 / 4294967296.0);
-    printf("odo-demo: %s square, %u ticks, %u frames published\n", ccw ? "ccw" : "cw", app.ticks,
-           app.ticks * 3U);
+    printf("odo-demo: %s square, %u ticks, %u frames published\n", ccw ? "ccw" : "cw", app.ticks, app.ticks * 3U);
     printf("  firmware believes  x %8.1f mm  y %8.1f mm  theta %7.2f deg\n", xc, yc, thc);
     printf("  robot really is    x %8.1f mm  y %8.1f mm  theta %7.2f deg\n", real.x_mm, real.y_mm,
            remainder(real.theta_rad * 180.0 / M_PI, 360.0));

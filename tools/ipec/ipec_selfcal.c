@@ -55,9 +55,9 @@ int ipec_write_params(odo_out_file_t *o, const odo_params_t *p)
  * ------------------------------------------------------------------------------------------- */
 typedef struct {
     odo_selfcal_t cal;
-    odo_params_t  p;            ///< what the firmware runs with
-    double        abs_corr_deg[ODO_TRUCKS]; ///< sum |C|
-    double        corr_deg[ODO_TRUCKS];     ///< sum C
+    odo_params_t p;                  ///< what the firmware runs with
+    double abs_corr_deg[ODO_TRUCKS]; ///< sum |C|
+    double corr_deg[ODO_TRUCKS];     ///< sum C
 } sc_ctx_t;
 
 static void sc_tick(void *user, const sim_tick_t *tk)
@@ -83,7 +83,7 @@ static double one_sided_deg(const odo_selfcal_truck_t *t)
 }
 
 static int selfcal_runs(const sim_robot_t *robot, const sim_scenario_t *sc, const char *exp, unsigned runs, int ipec,
-                      uint64_t seed, sc_ctx_t *ctx)
+                        uint64_t seed, sc_ctx_t *ctx)
 {
     char err[256];
     memset(ctx, 0, sizeof *ctx);
@@ -143,7 +143,7 @@ int ipec_selfcal(const sim_robot_t *robot, const sim_scenario_t *sc, const char 
  * 004 s. 5.2: rotary-encoder bias and link-length bias, against an external reference
  * ------------------------------------------------------------------------------------------- */
 typedef struct {
-    double far_x;             ///< firmware x of A at the far end (largest so far)
+    double far_x; ///< firmware x of A at the far end (largest so far)
     double e_theta_deg, e_y_mm;
 } far_t;
 
@@ -191,7 +191,7 @@ static int measure(const sim_robot_t *base, const sim_scenario_t *sc, const odo_
 /// The external reference of the calibration bay (004 s. 6: sonar on the vehicle; here the
 /// simulator's truth): both trucks' true poses every tick, hence the true alpha, beta and l.
 typedef struct {
-    double sum_a, sum_b, sum_l;     ///< code centre - true angle (deg) over sweep ticks; l_meas - l_true (mm)
+    double sum_a, sum_b, sum_l; ///< code centre - true angle (deg) over sweep ticks; l_meas - l_true (mm)
     unsigned n_a, n_b, n_l;
     uint16_t last_a, last_b;
     bool have_last;
@@ -390,15 +390,16 @@ int ipec_cmd_selfcal(int argc, char **argv, int link)
         if (ipec_write_params(&of, &r.params) != 0) {
             return 1;
         }
-        printf("{\n  \"experiment\": \"%s\", \"runs_per_direction\": %ld, \"params\": \"%s\",\n  \"truck\": [\n", exp, runs,
-               out);
+        printf("{\n  \"experiment\": \"%s\", \"runs_per_direction\": %ld, \"params\": \"%s\",\n  \"truck\": [\n", exp,
+               runs, out);
         for (unsigned i = 0; i < ODO_TRUCKS; ++i) {
-            printf("    {\"ed\": %.6f, \"eb\": %.6f, \"straight_m\": %.2f, \"turn_deg\": %.1f, "
-                   "\"corr_deg_per_m\": %.5f, \"corr_deg_per_turn\": %.4f, \"one_sided_corr_deg_before\": %.3f, "
-                   "\"one_sided_corr_deg_after\": %.3f, \"abs_corr_deg_before\": %.3f, \"abs_corr_deg_after\": %.3f}%s\n",
-                   r.ed[i], r.eb[i], r.straight_m[i], r.turn_deg[i], r.corr_deg_per_m[i], r.corr_deg_per_turn[i],
-                   r.one_sided_before_deg[i], r.one_sided_after_deg[i], r.abs_before_deg[i], r.abs_after_deg[i],
-                   i + 1U < ODO_TRUCKS ? "," : "");
+            printf(
+                "    {\"ed\": %.6f, \"eb\": %.6f, \"straight_m\": %.2f, \"turn_deg\": %.1f, "
+                "\"corr_deg_per_m\": %.5f, \"corr_deg_per_turn\": %.4f, \"one_sided_corr_deg_before\": %.3f, "
+                "\"one_sided_corr_deg_after\": %.3f, \"abs_corr_deg_before\": %.3f, \"abs_corr_deg_after\": %.3f}%s\n",
+                r.ed[i], r.eb[i], r.straight_m[i], r.turn_deg[i], r.corr_deg_per_m[i], r.corr_deg_per_turn[i],
+                r.one_sided_before_deg[i], r.one_sided_after_deg[i], r.abs_before_deg[i], r.abs_after_deg[i],
+                i + 1U < ODO_TRUCKS ? "," : "");
         }
         printf("  ]\n}\n");
         return 0;

@@ -203,8 +203,9 @@ static void print_json(FILE *f, const char *path, const uint8_t *b, const odo_pa
     const size_t crc_off = odo_params_version_size(le16(&b[4])) - 4U;
     fprintf(f, "{\"file\": ");
     json_str(f, path);
-    fprintf(f, ", \"status\": \"ok\", \"magic\": \"ODOP\", \"version\": %u, \"length\": %u, "
-               "\"crc32\": \"0x%08" PRIX32 "\",\n",
+    fprintf(f,
+            ", \"status\": \"ok\", \"magic\": \"ODOP\", \"version\": %u, \"length\": %u, "
+            "\"crc32\": \"0x%08" PRIX32 "\",\n",
             (unsigned)le16(&b[4]), (unsigned)le16(&b[6]), le32(&b[crc_off]));
     odo_params_json_fields(f, p, le16(&b[4]));
     fputs("}\n", f);
@@ -256,8 +257,7 @@ static int cmd_show(int argc, char **argv)
         return EXIT_REJECTED;
     }
     if (n > MAX_INPUT_BYTES) {
-        fprintf(stderr, "%s: %s: larger than %lu bytes, not a parameter block\n", k_prog, path,
-                MAX_INPUT_BYTES);
+        fprintf(stderr, "%s: %s: larger than %lu bytes, not a parameter block\n", k_prog, path, MAX_INPUT_BYTES);
         free(buf);
         return EXIT_REJECTED;
     }
@@ -302,39 +302,46 @@ static const char *scope_key(const char *scope)
 
 static void print_layout(FILE *f)
 {
-    fprintf(f, "{\"magic\": \"ODOP\", \"magic_u32\": %lu, \"version\": %u, \"size\": %u, "
-               "\"crc_offset\": %u, \"header_size\": %u, \"trucks\": %u,\n",
+    fprintf(f,
+            "{\"magic\": \"ODOP\", \"magic_u32\": %lu, \"version\": %u, \"size\": %u, "
+            "\"crc_offset\": %u, \"header_size\": %u, \"trucks\": %u,\n",
             (unsigned long)ODO_PARAMS_MAGIC, ODO_PARAMS_VERSION, ODO_PARAMS_SIZE, ODO_PARAMS_CRC_OFFSET,
             ODO_PARAMS_HEADER_SIZE, (unsigned)ODO_TRUCKS);
     fputs(" \"versions\": [", f);
     for (unsigned v = 1U; v <= ODO_PARAMS_VERSION; ++v) {
         const size_t size = odo_params_version_size((uint16_t)v);
-        fprintf(f, "%s{\"version\": %u, \"size\": %zu, \"crc_offset\": %zu}", v == 1U ? "" : ", ", v, size,
-                size - 4U);
+        fprintf(f, "%s{\"version\": %u, \"size\": %zu, \"crc_offset\": %zu}", v == 1U ? "" : ", ", v, size, size - 4U);
     }
     fputs("],\n \"header\": [{\"name\": \"magic\", \"offset\": 0, \"width\": 4, \"type\": \"u32\"}, "
           "{\"name\": \"version\", \"offset\": 4, \"width\": 2, \"type\": \"u16\"}, "
           "{\"name\": \"length\", \"offset\": 6, \"width\": 2, \"type\": \"u16\"}],\n"
-          " \"checks\": [\"link.length_min_um < link.length_max_um\"],\n \"fields\": [", f);
+          " \"checks\": [\"link.length_min_um < link.length_max_um\"],\n \"fields\": [",
+          f);
     const char *sep = "\n  ";
     /* Straight from the X-macro: every column as written in odo_params.h. */
-#define LAYOUT_ROW(id, scope, member, json, since, off, stride, type, lo, hi, unit)                         \
-    do {                                                                                                  \
-        const odo_param_field_info_t *fi = odo_params_field_info(ODO_PF_##id);                              \
-        fprintf(f, "%s{\"id\": \"%s\", \"name\": \"%s\", \"scope\": \"%s\", \"member\": \"%s\", "                \
-                   "\"since\": %d, \"offsets\": [%d", sep, #id, json, scope_key(#scope), #member, since, off);   \
-        if (strcmp(#scope, "TRUCK") == 0) {                                                               \
-            for (unsigned t = 1U; t < ODO_TRUCKS; ++t) {                                                  \
-                fprintf(f, ", %d", (off) + (int)t * (stride));                                              \
-            }                                                                                             \
-        }                                                                                                 \
-        fprintf(f, "], \"width\": %u, \"type\": \"%s\", \"signed\": %s, \"min\": %" PRId64                \
-                   ", \"max\": %" PRId64 ", \"unit\": \"%s\", \"enum\": %u}",                                    \
-                fi->width, strcmp(#type, "I32") == 0 ? "i32" : strcmp(#type, "U32") == 0 ? "u32"            \
-                                                      : strcmp(#type, "U16") == 0 ? "u16" : "u8",           \
-                strcmp(#type, "I32") == 0 ? "true" : "false", (int64_t)(lo), (int64_t)(hi), unit,          \
-                (unsigned)ODO_PF_##id);                                                                   \
-        sep = ",\n  ";                                                                                    \
+#define LAYOUT_ROW(id, scope, member, json, since, off, stride, type, lo, hi, unit)                           \
+    do {                                                                                                      \
+        const odo_param_field_info_t *fi = odo_params_field_info(ODO_PF_##id);                                \
+        fprintf(f,                                                                                            \
+                "%s{\"id\": \"%s\", \"name\": \"%s\", \"scope\": \"%s\", \"member\": \"%s\", "                \
+                "\"since\": %d, \"offsets\": [%d",                                                            \
+                sep, #id, json, scope_key(#scope), #member, since, off);                                      \
+        if (strcmp(#scope, "TRUCK") == 0) {                                                                   \
+            for (unsigned t = 1U; t < ODO_TRUCKS; ++t) {                                                      \
+                fprintf(f, ", %d", (off) + (int)t * (stride));                                                \
+            }                                                                                                 \
+        }                                                                                                     \
+        fprintf(f,                                                                                            \
+                "], \"width\": %u, \"type\": \"%s\", \"signed\": %s, \"min\": %" PRId64 ", \"max\": %" PRId64 \
+                ", \"unit\": \"%s\", \"enum\": %u}",                                                          \
+                fi->width,                                                                                    \
+                strcmp(#type, "I32") == 0   ? "i32"                                                           \
+                : strcmp(#type, "U32") == 0 ? "u32"                                                           \
+                : strcmp(#type, "U16") == 0 ? "u16"                                                           \
+                                            : "u8",                                                           \
+                strcmp(#type, "I32") == 0 ? "true" : "false", (int64_t)(lo), (int64_t)(hi), unit,             \
+                (unsigned)ODO_PF_##id);                                                                       \
+        sep = ",\n  ";                                                                                        \
     } while (0);
     ODO_PARAMS_FIELDS(LAYOUT_ROW)
 #undef LAYOUT_ROW

@@ -35,51 +35,49 @@
 
 static void usage(FILE *f)
 {
-    fprintf(f,
-            "usage: odo-replay --log RUN.log  (--robot R.json | --params P) [options] --out DIR\n"
-            "       odo-replay --iface vcan0  (--robot R.json | --params P) [options] [--out DIR]\n"
-            "       odo-replay --help | --version\n"
-            "\n"
-            "Runs the firmware's 40 ms step on CAN sensor frames (WHEEL_COUNTS_A/B, LINK_ROTARY,\n"
-            "LINK_LINEAR; can/odometry.dbc) read from a candump -l log or a SocketCAN interface,\n"
-            "on the frames' timestamps (tick k collects the frames within half a period of\n"
-            "t0 + k * 40 ms). Live mode publishes the output frames on the interface.\n"
-            "\n"
-            "  --robot R.json     robot description (host_sim/robots/*.json) -> parameters\n"
-            "  --params P         parameter block, raw (P.bin) or JSON (P.json, odo-params show);\n"
-            "                     overrides --robot\n"
-            "  --ipec MODE        off, on (= paper), paper or estimator, as in odo-sim;\n"
-            "                     default: what the robot/parameters say (odo-sim's default is off)\n"
-            "  --out DIR          poses.csv, out.log (output frames, candump -l), summary.json;\n"
-            "                     missing parents are created; an existing DIR must be empty or a\n"
-            "                     previous odo-replay output (.odo-manifest), unless --force\n"
-            "  --force            write into a non-empty folder odo-replay did not write (same-named\n"
-            "                     files are replaced, nothing is removed)\n"
-            "  --out-iface NAME   interface name written in out.log (default: the input's)\n"
-            "  --idle-exit S      live: exit S seconds after the last frame (default: run until\n"
-            "                     SIGINT/SIGTERM)\n"
-            "  --no-send          live: do not publish the output frames on the bus\n"
-            "  --margin-ms M      live: close a tick M ms after its last frame may arrive (default 5)\n"
-            "  --quiet            no progress on stderr\n"
-            "\n"
-            "Exit status: 0 done, 1 bad input (the message names file and line), 2 usage.\n");
+    fprintf(f, "usage: odo-replay --log RUN.log  (--robot R.json | --params P) [options] --out DIR\n"
+               "       odo-replay --iface vcan0  (--robot R.json | --params P) [options] [--out DIR]\n"
+               "       odo-replay --help | --version\n"
+               "\n"
+               "Runs the firmware's 40 ms step on CAN sensor frames (WHEEL_COUNTS_A/B, LINK_ROTARY,\n"
+               "LINK_LINEAR; can/odometry.dbc) read from a candump -l log or a SocketCAN interface,\n"
+               "on the frames' timestamps (tick k collects the frames within half a period of\n"
+               "t0 + k * 40 ms). Live mode publishes the output frames on the interface.\n"
+               "\n"
+               "  --robot R.json     robot description (host_sim/robots/*.json) -> parameters\n"
+               "  --params P         parameter block, raw (P.bin) or JSON (P.json, odo-params show);\n"
+               "                     overrides --robot\n"
+               "  --ipec MODE        off, on (= paper), paper or estimator, as in odo-sim;\n"
+               "                     default: what the robot/parameters say (odo-sim's default is off)\n"
+               "  --out DIR          poses.csv, out.log (output frames, candump -l), summary.json;\n"
+               "                     missing parents are created; an existing DIR must be empty or a\n"
+               "                     previous odo-replay output (.odo-manifest), unless --force\n"
+               "  --force            write into a non-empty folder odo-replay did not write (same-named\n"
+               "                     files are replaced, nothing is removed)\n"
+               "  --out-iface NAME   interface name written in out.log (default: the input's)\n"
+               "  --idle-exit S      live: exit S seconds after the last frame (default: run until\n"
+               "                     SIGINT/SIGTERM)\n"
+               "  --no-send          live: do not publish the output frames on the bus\n"
+               "  --margin-ms M      live: close a tick M ms after its last frame may arrive (default 5)\n"
+               "  --quiet            no progress on stderr\n"
+               "\n"
+               "Exit status: 0 done, 1 bad input (the message names file and line), 2 usage.\n");
 }
 
 typedef struct {
-    FILE          *csv;
-    FILE          *log;
-    char           iface[CANDUMP_IFACE_MAX + 1];
-    hal_socketcan_t *sc;      ///< live: publish here (NULL: offline or --no-send)
-    int            quiet;
-    int            io_error;
-    uint64_t       out_frames;
+    FILE *csv;
+    FILE *log;
+    char iface[CANDUMP_IFACE_MAX + 1];
+    hal_socketcan_t *sc; ///< live: publish here (NULL: offline or --no-send)
+    int quiet;
+    int io_error;
+    uint64_t out_frames;
 } sink_t;
 
 static double q32_mm(int64_t v) { return (double)v / 4294967296.0; }
 static double q64_deg(uint64_t h) { return ldexp((double)h, -64) * 360.0; }
 
-static void on_tick(void *user, replay_t *r, uint64_t tick, const odo_tick_input_t *in,
-                    const odo_tick_output_t *out)
+static void on_tick(void *user, replay_t *r, uint64_t tick, const odo_tick_input_t *in, const odo_tick_output_t *out)
 {
     sink_t *s = user;
     char line[CANDUMP_LINE_MAX];
@@ -94,12 +92,12 @@ static void on_tick(void *user, replay_t *r, uint64_t tick, const odo_tick_input
     const odo_pose_t *a = &out->pose[ODO_TRUCK_A], *b = &out->pose[ODO_TRUCK_B];
     /* t_s: the tick's time on the log's clock relative to the first tick (steps back after a
      * clock step, jumps over a skipped gap; replay.h). */
-    const double t_s = in->t_us >= r->origin_us ? (double)(in->t_us - r->origin_us) / 1e6
-                                                : -(double)(r->origin_us - in->t_us) / 1e6;
-    fprintf(s->csv, "%" PRIu64 ",%.6f,%.6f,%.6f,%.9f,%.6f,%.6f,%.9f,%" PRId32 ",%" PRId32 ",0x%05" PRIX32 "\n",
-            tick, t_s, q32_mm(a->x_mm_q32), q32_mm(a->y_mm_q32),
-            q64_deg(a->heading_q64), q32_mm(b->x_mm_q32), q32_mm(b->y_mm_q32), q64_deg(b->heading_q64),
-            out->ipec_dtheta_bam[0], out->ipec_dtheta_bam[1], out->faults);
+    const double t_s =
+        in->t_us >= r->origin_us ? (double)(in->t_us - r->origin_us) / 1e6 : -(double)(r->origin_us - in->t_us) / 1e6;
+    fprintf(s->csv, "%" PRIu64 ",%.6f,%.6f,%.6f,%.9f,%.6f,%.6f,%.9f,%" PRId32 ",%" PRId32 ",0x%05" PRIX32 "\n", tick,
+            t_s, q32_mm(a->x_mm_q32), q32_mm(a->y_mm_q32), q64_deg(a->heading_q64), q32_mm(b->x_mm_q32),
+            q32_mm(b->y_mm_q32), q64_deg(b->heading_q64), out->ipec_dtheta_bam[0], out->ipec_dtheta_bam[1],
+            out->faults);
     if (!s->quiet && tick > 0U && tick % PROGRESS_TICKS == 0U) {
         fprintf(stderr, "odo-replay: %" PRIu64 " ticks (%.0f s of log)\n", tick, t_s);
     }
@@ -155,8 +153,8 @@ static int set_u64(json_t *o, const char *key, uint64_t v)
 }
 
 /// summary.json, built with jansson so every string is escaped. Returns 0, or -1 on a write error.
-static int write_summary(FILE *f, const char *mode, const char *input, const replay_t *r,
-                         const hal_log_stats_t *ls, const hal_sc_stats_t *ss, const sink_t *s)
+static int write_summary(FILE *f, const char *mode, const char *input, const replay_t *r, const hal_log_stats_t *ls,
+                         const hal_sc_stats_t *ss, const sink_t *s)
 {
     const replay_stats_t *st = &r->stats;
     json_t *o = json_object();
@@ -216,8 +214,10 @@ static void report_gaps(const replay_t *r, uint64_t *seen, const char *where)
     if (*seen > GAP_REPORTS) {
         return;
     }
-    fprintf(stderr, "odo-replay: %s: a gap of %.6g s in the frames (more than %u ticks): skipped, not stepped "
-                    "through%s\n", where, (double)r->stats.last_gap_us / 1e6, REPLAY_MAX_GAP_TICKS,
+    fprintf(stderr,
+            "odo-replay: %s: a gap of %.6g s in the frames (more than %u ticks): skipped, not stepped "
+            "through%s\n",
+            where, (double)r->stats.last_gap_us / 1e6, REPLAY_MAX_GAP_TICKS,
             *seen == GAP_REPORTS ? " (further gaps only in summary.json)" : "");
 }
 
@@ -308,17 +308,36 @@ int main(int argc, char **argv)
     int ipec = -1, quiet = 0, no_send = 0;
     bool force = false;
     double idle_exit_s = 0.0, margin_ms = 5.0;
-    enum { O_LOG = 256, O_IFACE, O_ROBOT, O_PARAMS, O_OUT, O_OUT_IFACE, O_IPEC, O_IDLE, O_MARGIN, O_NO_SEND,
-           O_FORCE, O_QUIET, O_VERSION };
-    static const struct option longopts[] = {
-        {"log", required_argument, NULL, O_LOG},          {"iface", required_argument, NULL, O_IFACE},
-        {"robot", required_argument, NULL, O_ROBOT},      {"params", required_argument, NULL, O_PARAMS},
-        {"out", required_argument, NULL, O_OUT},          {"out-iface", required_argument, NULL, O_OUT_IFACE},
-        {"ipec", required_argument, NULL, O_IPEC},        {"idle-exit", required_argument, NULL, O_IDLE},
-        {"margin-ms", required_argument, NULL, O_MARGIN}, {"no-send", no_argument, NULL, O_NO_SEND},
-        {"force", no_argument, NULL, O_FORCE},            {"quiet", no_argument, NULL, O_QUIET},
-        {"version", no_argument, NULL, O_VERSION},        {"help", no_argument, NULL, 'h'},
-        {NULL, 0, NULL, 0}};
+    enum {
+        O_LOG = 256,
+        O_IFACE,
+        O_ROBOT,
+        O_PARAMS,
+        O_OUT,
+        O_OUT_IFACE,
+        O_IPEC,
+        O_IDLE,
+        O_MARGIN,
+        O_NO_SEND,
+        O_FORCE,
+        O_QUIET,
+        O_VERSION
+    };
+    static const struct option longopts[] = {{"log", required_argument, NULL, O_LOG},
+                                             {"iface", required_argument, NULL, O_IFACE},
+                                             {"robot", required_argument, NULL, O_ROBOT},
+                                             {"params", required_argument, NULL, O_PARAMS},
+                                             {"out", required_argument, NULL, O_OUT},
+                                             {"out-iface", required_argument, NULL, O_OUT_IFACE},
+                                             {"ipec", required_argument, NULL, O_IPEC},
+                                             {"idle-exit", required_argument, NULL, O_IDLE},
+                                             {"margin-ms", required_argument, NULL, O_MARGIN},
+                                             {"no-send", no_argument, NULL, O_NO_SEND},
+                                             {"force", no_argument, NULL, O_FORCE},
+                                             {"quiet", no_argument, NULL, O_QUIET},
+                                             {"version", no_argument, NULL, O_VERSION},
+                                             {"help", no_argument, NULL, 'h'},
+                                             {NULL, 0, NULL, 0}};
     for (int c; (c = getopt_long(argc, argv, "h", longopts, NULL)) != -1;) {
         switch (c) {
         case 'h': usage(stdout); return 0;
@@ -475,25 +494,32 @@ int main(int argc, char **argv)
         replay_finish(&r);
     }
     if (r.stats.time_backwards > 0U && !quiet) {
-        fprintf(stderr, "odo-replay: warning: %" PRIu64 " frames stamped before the previous frame "
-                        "(flagged TIME_BACKWARDS)\n", r.stats.time_backwards);
+        fprintf(stderr,
+                "odo-replay: warning: %" PRIu64 " frames stamped before the previous frame "
+                "(flagged TIME_BACKWARDS)\n",
+                r.stats.time_backwards);
     }
     if (r.stats.clock_steps > 0U && !quiet) {
-        fprintf(stderr, "odo-replay: warning: the clock stepped back %" PRIu64 " time(s) by more than %u ticks; "
-                        "the tick clock was re-anchored each time\n", r.stats.clock_steps, REPLAY_CLOCK_STEP_TICKS);
+        fprintf(stderr,
+                "odo-replay: warning: the clock stepped back %" PRIu64 " time(s) by more than %u ticks; "
+                "the tick clock was re-anchored each time\n",
+                r.stats.clock_steps, REPLAY_CLOCK_STEP_TICKS);
     }
     if (r.stats.gaps > 0U) { /* reported even with --quiet: the output has a hole */
-        fprintf(stderr, "odo-replay: warning: %" PRIu64 " gap(s) longer than %u ticks skipped, %.6g s in all "
-                        "(longest %.6g s)\n", r.stats.gaps, REPLAY_MAX_GAP_TICKS, (double)r.stats.gap_us / 1e6,
-                (double)r.stats.longest_gap_us / 1e6);
+        fprintf(stderr,
+                "odo-replay: warning: %" PRIu64 " gap(s) longer than %u ticks skipped, %.6g s in all "
+                "(longest %.6g s)\n",
+                r.stats.gaps, REPLAY_MAX_GAP_TICKS, (double)r.stats.gap_us / 1e6, (double)r.stats.longest_gap_us / 1e6);
     }
     if (log != NULL && reader.stats.fd_skipped > 0U && !quiet) {
         fprintf(stderr, "odo-replay: %" PRIu64 " CAN FD lines (another node's traffic) skipped\n",
                 reader.stats.fd_skipped);
     }
     if (r.stats.ignored > 0U && !quiet) {
-        fprintf(stderr, "odo-replay: %" PRIu64 " frames not consumed (unknown ID, RTR, extended or output "
-                        "frames) ignored\n", r.stats.ignored);
+        fprintf(stderr,
+                "odo-replay: %" PRIu64 " frames not consumed (unknown ID, RTR, extended or output "
+                "frames) ignored\n",
+                r.stats.ignored);
     }
 
     if (out != NULL) {
@@ -522,8 +548,8 @@ int main(int argc, char **argv)
         fclose(sink.log);
     }
     if (rc == 0 && !quiet) {
-        fprintf(stderr, "odo-replay: %" PRIu64 " ticks from %" PRIu64 " frames%s%s\n", r.stats.ticks,
-                r.stats.frames, out != NULL ? " -> " : "", out != NULL ? out : "");
+        fprintf(stderr, "odo-replay: %" PRIu64 " ticks from %" PRIu64 " frames%s%s\n", r.stats.ticks, r.stats.frames,
+                out != NULL ? " -> " : "", out != NULL ? out : "");
     }
     hal_log_close(&reader);
     hal_socketcan_close(&sc);
