@@ -1,5 +1,5 @@
 /// hal_sim: the simulator's HAL backend. The firmware's wheel counters come out of HCTL-1100-style
-/// decoder emulators (host_sim/src/hctl1100.h), read only through the chip's byte-wise register
+/// decoder emulators (hal/sim/hctl1100.h), read only through the chip's byte-wise register
 /// protocol, so firmware that works here reads the real chip the same way. The linkage encoders
 /// are quantised like the real absolute encoders; transmitted frames are captured for the
 /// simulator to log. No threads, no I/O, no heap, no randomness: identical calls give identical
