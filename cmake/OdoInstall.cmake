@@ -5,7 +5,7 @@
 #   PREFIX/lib/libodosim.so          the simulator's C API for tools (the Python tools load it)
 #   PREFIX/include/odosim/odosim.h   its header
 #   PREFIX/share/odometry/           laid out as in the repository, so the CLIs' and the Python
-#                                    tools' data lookup is one rule (tools/lib/data_dir.h):
+#                                    tools' data lookup is one rule (hostlib/odo_data_dir.h):
 #     can/odometry.dbc               the single source of truth for every frame
 #     host_sim/robots/*.json         example robot descriptions (and OptiOdom's, from gap/robots)
 #     host_sim/scenarios/*.json      example simulator scenarios

@@ -1,8 +1,8 @@
-/// libFuzzer harness: the parameter block as JSON (tools/lib/params_json.h, jansson) and the
+/// libFuzzer harness: the parameter block as JSON (hostlib/odo_params_json.h, jansson) and the
 /// loader that tells a JSON file from a raw block by content. Whatever is accepted is a block
 /// the firmware accepts (odo_params_validate) and writes back to JSON that parses to the same.
 #include "fuzz_common.h"
-#include "params_json.h"
+#include "odo_params_json.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 

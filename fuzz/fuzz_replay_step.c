@@ -13,7 +13,7 @@
 #include "odo/odo_can.h"
 #include "odo/odo_params.h"
 #include "replay.h"
-#include "robot.h"
+#include "odo_robot.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 int LLVMFuzzerInitialize(int *argc, char ***argv);

@@ -1,9 +1,9 @@
-/// libFuzzer harness: the simulator's robot description and scenario JSON (host_sim/src/robot.h,
+/// libFuzzer harness: the simulator's robot description and scenario JSON (hostlib/odo_robot.h,
 /// effects.h): one validator each, the limits table the Python tools use too. Any text: an error
 /// naming the origin, or a description that converts to a parameter block the firmware accepts.
 #include "effects.h"
 #include "fuzz_common.h"
-#include "robot.h"
+#include "odo_robot.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 

@@ -65,7 +65,7 @@ void hal_log_close(hal_log_t *l);
 
 /// Format one frame as a candump -l line ("(sec.usec) iface ID#DATA\n", upper-case hex, 3- or
 /// 8-digit ID, "R" for remote requests, error frames with the 0x20000000 bit) into buf. Returns the
-/// length written (no NUL), at most CANDUMP_LINE_MAX. The same text as tools/lib candump.h writes.
+/// length written (no NUL), at most CANDUMP_LINE_MAX. hostlib/odo_candump.h writes files through it.
 #define CANDUMP_LINE_MAX 80U
 size_t candump_format_line(char *buf, uint64_t t_us, const char *iface, const odo_can_frame_t *f);
 

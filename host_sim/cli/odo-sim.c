@@ -14,14 +14,14 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include "candump.h"
-#include "data_dir.h"
+#include "odo_candump.h"
+#include "odo_data_dir.h"
 #include "odo_cli.h"
 #include "odo_out.h"
-#include "params_json.h"
+#include "odo_params_json.h"
 #include "effects.h"
 #include "odo/odo_can.h"
-#include "robot.h"
+#include "odo_robot.h"
 #include "sil.h"
 #include "summary.h"
 
@@ -276,7 +276,7 @@ int main(int argc, char **argv)
     char err[512];
     char default_robot[PATH_MAX];
     if (robot_path == NULL) {
-        /* The stock descriptions: the checkout's, or the installed ones (tools/lib/data_dir.h). */
+        /* The stock descriptions: the checkout's, or the installed ones (hostlib/odo_data_dir.h). */
         char rel[96];
         snprintf(rel, sizeof rel, "host_sim/robots/%s.json", vehicle_name);
         if (odo_data_path(rel, default_robot, sizeof default_robot) != 0) {

@@ -7,7 +7,7 @@
 #include <string.h>
 
 #include "effects.h"
-#include "robot.h"
+#include "odo_robot.h"
 #include "sil.h"
 
 struct odosim_setup {

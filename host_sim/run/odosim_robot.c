@@ -8,7 +8,7 @@
 
 #include "odo/odo_app.h"
 #include "odosim/odosim.h"
-#include "robot.h"
+#include "odo_robot.h"
 
 char *odosim_robot_describe(const char *robot_path, char *err, size_t errlen)
 {

@@ -13,7 +13,7 @@
 #include "effects.h"
 #include "odo/odo_app.h"
 #include "program.h"
-#include "robot.h"
+#include "odo_robot.h"
 #include "summary.h"
 #include "world.h"
 

@@ -42,7 +42,7 @@
 
 #include "bump.h"
 #include "effects.h"
-#include "robot.h"
+#include "odo_robot.h"
 
 #define SIM_WORLD_DEFAULT_DT_S 0.001 ///< 1 ms physics step
 #define SIM_WORLD_MAX_DT_S     0.1   ///< larger steps are refused

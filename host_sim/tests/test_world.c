@@ -11,7 +11,7 @@
 #include "bump.h"
 #include "effects.h"
 #include "odo/odo_params.h"
-#include "robot.h"
+#include "odo_robot.h"
 #include "world.h"
 
 #ifndef ODOSIM_SOURCE_DIR

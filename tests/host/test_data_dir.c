@@ -1,5 +1,5 @@
-/// Where an installed or build-tree CLI finds its shipped files (tools/lib/data_dir.h), and a
-/// recorded log's start time (tools/lib/candump.h: --log-start, SOURCE_DATE_EPOCH). The installed
+/// Where an installed or build-tree CLI finds its shipped files (hostlib/odo_data_dir.h), and a
+/// recorded log's start time (hostlib/odo_candump.h: --log-start, SOURCE_DATE_EPOCH). The installed
 /// layout itself (PREFIX/bin -> PREFIX/share/odometry) is exercised by tests/package.
 #include <check.h>
 
@@ -8,9 +8,9 @@
 #include <sys/stat.h>
 #include <time.h>
 
-#include "candump.h"
+#include "odo_candump.h"
 #include "check_support.h"
-#include "data_dir.h"
+#include "odo_data_dir.h"
 
 static int is_file(const char *p)
 {

@@ -20,7 +20,7 @@
 #include "odo_hctl_bus.h"
 #include "odo_iwdg.h"
 #include "odo_timer.h"
-#include "robot.h"
+#include "odo_robot.h"
 
 #define POLLS 1000U
 

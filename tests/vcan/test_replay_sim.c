@@ -12,11 +12,11 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "candump.h"
+#include "odo_candump.h"
 #include "hal_log.h"
 #include "odo/odo_can.h"
 #include "replay.h"
-#include "robot.h"
+#include "odo_robot.h"
 #include "sil.h"
 #include "test_support.h"
 

@@ -19,7 +19,7 @@
 #include "odo_refcheck.h"
 #include "odo_synth.h"
 #include "replay_bench.h"
-#include "robot.h"
+#include "odo_robot.h"
 #include "sil.h"
 #include "trig_accuracy.h"
 

@@ -17,7 +17,7 @@
 #include "hal_log.h"
 #include "odo/odo_params.h"
 #include "replay.h"
-#include "robot.h"
+#include "odo_robot.h"
 
 typedef struct {
     FILE *f;

@@ -25,7 +25,7 @@
 
 #include "calib_core.h"
 #include "effects.h"
-#include "robot.h"
+#include "odo_robot.h"
 #include "sil.h"
 
 #define Q30        1073741824.0

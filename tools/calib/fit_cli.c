@@ -8,8 +8,8 @@
 #include "fit_cli.h"
 #include "fit_data.h"
 #include "fit_model.h"
-#include "params_json.h"
-#include "robot.h"
+#include "odo_params_json.h"
+#include "odo_robot.h"
 
 #define MAX_ARGS 64
 

@@ -13,7 +13,7 @@
 #include "hal_log.h"
 #include "odo/odo_odometry.h"
 #include "replay.h"
-#include "robot.h"
+#include "odo_robot.h"
 
 #if defined(__GNUC__)
 __attribute__((format(printf, 3, 4)))

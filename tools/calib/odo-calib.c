@@ -22,10 +22,10 @@
 #include "image.h"
 #include "odo_cli.h"
 #include "odo_out.h"
-#include "params_diag.h"
-#include "params_json.h"
+#include "odo_params_diag.h"
+#include "odo_params_json.h"
 #include "returns_csv.h"
-#include "robot.h"
+#include "odo_robot.h"
 
 #define EXIT_FAIL  1
 #define EXIT_USAGE 2

@@ -15,7 +15,7 @@
 #include <string.h>
 #include <sys/stat.h>
 
-#include "candump.h"
+#include "odo_candump.h"
 #include "hal_test.h"
 #include "odo/odo_app.h"
 #include "odo_cli.h"

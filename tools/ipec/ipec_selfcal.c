@@ -9,7 +9,7 @@
 
 #include "ipec_tool.h"
 #include "odo/odo_selfcal.h"
-#include "params_json.h"
+#include "odo_params_json.h"
 
 static const double TWO30 = 1073741824.0;
 

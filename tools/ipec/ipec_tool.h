@@ -8,11 +8,11 @@
 
 #include "effects.h"
 #include "odo/odo_odometry.h"
-#include "robot.h"
+#include "odo_robot.h"
 #include "sil.h"
 #include "summary.h"
 
-/// The data root: $ODO_SOURCE_DIR, the checkout, or PREFIX/share/odometry (tools/lib/data_dir.h).
+/// The data root: $ODO_SOURCE_DIR, the checkout, or PREFIX/share/odometry (hostlib/odo_data_dir.h).
 const char *ipec_src_dir(void);
 
 /// Robot (default host_sim/robots/<vehicle>.json) and scenario (NULL: no effects). 0 or -1 (printed).

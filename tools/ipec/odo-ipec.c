@@ -9,7 +9,7 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "data_dir.h"
+#include "odo_data_dir.h"
 #include "odo_cli.h"
 #include "ipec_tool.h"
 

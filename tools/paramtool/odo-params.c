@@ -22,8 +22,8 @@
 #include "odo/odo_params.h"
 #include "odo_cli.h"
 #include "odo_out.h"
-#include "params_diag.h"
-#include "params_json.h"
+#include "odo_params_diag.h"
+#include "odo_params_json.h"
 
 #define EXIT_REJECTED 1
 #define EXIT_USAGE    2

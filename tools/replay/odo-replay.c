@@ -27,9 +27,9 @@
 #include "odo_out.h"
 #include "odo/odo_can.h"
 #include "odo/odo_params.h"
-#include "params_json.h"
+#include "odo_params_json.h"
 #include "replay.h"
-#include "robot.h"
+#include "odo_robot.h"
 
 #define PROGRESS_TICKS 25000U
 

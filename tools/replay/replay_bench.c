@@ -18,7 +18,7 @@
 #include "hal_log.h"
 #include "odo/odo_can.h"
 #include "replay.h"
-#include "robot.h"
+#include "odo_robot.h"
 #include "sil.h"
 
 #define BENCH_TICKS 90000UL /* one hour at 40 ms */

@@ -127,7 +127,7 @@ void odosim_free(void *p);
  * either (host_sim/run/odosim_robot.c).
  * ------------------------------------------------------------------------------------------- */
 
-/// Parse and validate a robot description with THE validator (host_sim/src/robot.c's limits table
+/// Parse and validate a robot description with THE validator (hostlib/odo_robot.c's limits table
 /// and odo_params_validate) and return what it means as compact JSON (malloc'd; odosim_free):
 /// {"vehicle", "tick_ms", "heading_form", "max_wheel_speed_mm_s", "trucks": [{"wheel_diameter_mm",
 /// "wheelbase_mm", "encoder_lines", "gear_ratio", "counter_bits", "invert_left", "invert_right",

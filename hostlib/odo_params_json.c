@@ -1,5 +1,5 @@
 /// Parameter block JSON. See params_json.h.
-#include "params_json.h"
+#include "odo_params_json.h"
 
 #include <errno.h>
 #include <inttypes.h>
@@ -9,7 +9,7 @@
 #include <string.h>
 #include <sys/stat.h>
 
-#include "params_diag.h"
+#include "odo_params_diag.h"
 
 #define LINK_PREFIX "link."
 

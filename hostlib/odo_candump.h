@@ -24,8 +24,10 @@ int odo_log_start_parse(const char *text, uint64_t *start_us);
 /// SOURCE_DATE_EPOCH is set but not whole seconds 0..ODO_LOG_START_MAX_S.
 int odo_log_start_default(uint64_t *start_us);
 
-/// Write one frame as a candump -l line: 3-hex standard or 8-hex extended ID, data in upper-case
-/// hex, "R" for remote frames. Returns 0, or -1 if the stream reported an error.
+/// Write one frame as a candump -l line, the text of hal/log's formatter (candump_format_line in
+/// hal_log.h: 3-hex standard or 8-hex extended ID, data in upper-case hex, "R" for remote frames,
+/// error frames with the 0x20000000 bit), so one formatter serves the writer and the parser's
+/// tests. Returns 0, or -1 if the stream reported an error.
 int odo_candump_write(FILE *f, uint64_t t_us, const char *iface, const odo_can_frame_t *frame);
 
 #endif

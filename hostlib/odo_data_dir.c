@@ -1,4 +1,4 @@
-#include "data_dir.h"
+#include "odo_data_dir.h"
 
 #include <limits.h>
 #include <stdio.h>

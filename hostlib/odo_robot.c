@@ -1,5 +1,5 @@
 /// Robot description JSON reader and conversion to odo_params_t; see robot.h for the schema.
-#include "robot.h"
+#include "odo_robot.h"
 
 #include "odo/odo_odometry.h"
 

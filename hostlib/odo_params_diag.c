@@ -1,5 +1,5 @@
 /// Parameter block diagnostics. See params_diag.h.
-#include "params_diag.h"
+#include "odo_params_diag.h"
 
 #include <inttypes.h>
 #include <stdio.h>
