@@ -19,11 +19,9 @@
 #include "odo_cli.h"
 #include "odo_out.h"
 #include "odo_params_json.h"
-#include "effects.h"
 #include "odo/odo_can.h"
 #include "odo_robot.h"
-#include "sil.h"
-#include "summary.h"
+#include "odosim/odosim_sil.h"
 
 #define MAX_RUNS 100
 
@@ -61,7 +59,7 @@ typedef struct {
     int io_error;
 } run_files_t;
 
-static void write_sensor_frames(run_files_t *rf, const sim_tick_t *tk)
+static void write_sensor_frames(run_files_t *rf, const odosim_tick_t *tk)
 {
     const odo_tick_input_t *in = tk->input;
     odo_can_frame_t f;
@@ -87,7 +85,7 @@ static void write_sensor_frames(run_files_t *rf, const sim_tick_t *tk)
     }
 }
 
-static void on_tick(void *user, const sim_tick_t *tk)
+static void on_tick(void *user, const odosim_tick_t *tk)
 {
     run_files_t *rf = user;
     write_sensor_frames(rf, tk);
@@ -98,14 +96,14 @@ static void on_tick(void *user, const sim_tick_t *tk)
             tk->truth[0].theta_rad * deg, tk->truth[1].x_mm, tk->truth[1].y_mm, tk->truth[1].theta_rad * deg,
             tk->link.alpha_rad * deg, tk->link.beta_rad * deg, tk->link.length_mm);
     for (size_t i = 0; i < tk->n_events; ++i) {
-        const sim_bump_event_t *e = &tk->events[i];
+        const odosim_event_t *e = &tk->events[i];
         fprintf(rf->truth, "%sbump:%c:%s:h%.3f:x%.3f:y%.3f", i ? "|" : "", e->truck ? 'B' : 'A',
                 e->wheel == ODO_LEFT ? "left" : "right", e->height_mm, e->x_mm, e->y_mm);
     }
     fputc('\n', rf->truth);
 }
 
-static int write_returns(odo_out_dir_t *dir, const sim_return_t *r, size_t n, int straight, char *err, size_t errlen)
+static int write_returns(odo_out_dir_t *dir, const odosim_return_t *r, size_t n, int straight, char *err, size_t errlen)
 {
     FILE *f = odo_out_dir_fopen(dir, "returns.csv", err, errlen);
     if (f == NULL) {
@@ -120,10 +118,10 @@ static int write_returns(odo_out_dir_t *dir, const sim_return_t *r, size_t n, in
 }
 
 static int write_summary(odo_out_dir_t *dir, const char *experiment, const char *vehicle, unsigned runs, uint64_t seed,
-                         const sim_return_t *r, size_t n, int straight, char *err, size_t errlen)
+                         const odosim_return_t *r, size_t n, int straight, char *err, size_t errlen)
 {
-    sim_summary_t s;
-    sim_summarise(r, n, &s);
+    odosim_summary_t s;
+    odosim_summarise(r, n, &s);
     FILE *f = odo_out_dir_fopen(dir, "summary.json", err, errlen);
     if (f == NULL) {
         return -1;
@@ -250,7 +248,7 @@ int main(int argc, char **argv)
         return 2;
     }
     if (list_effects) {
-        return (list_json ? sim_effects_write_json(stdout) : sim_effects_write_markdown(stdout)) == 0 ? 0 : 1;
+        return (list_json ? odosim_effects_write_json(stdout) : odosim_effects_write_markdown(stdout)) == 0 ? 0 : 1;
     }
     if (experiment == NULL || vehicle_name == NULL || scenario_path == NULL || out == NULL) {
         fprintf(stderr, "odo-sim: --experiment, --vehicle, --scenario and --out are required\n");
@@ -258,7 +256,7 @@ int main(int argc, char **argv)
         return 2;
     }
     int known = 0;
-    for (const char *const *n = sim_experiment_names; *n != NULL; ++n) {
+    for (const char *const *n = odosim_experiment_names(); *n != NULL; ++n) {
         known |= strcmp(*n, experiment) == 0;
     }
     if (!known) {
@@ -272,7 +270,6 @@ int main(int argc, char **argv)
         return 2;
     }
     static sim_robot_t robot;
-    static sim_scenario_t scenario;
     char err[512];
     char default_robot[PATH_MAX];
     if (robot_path == NULL) {
@@ -318,12 +315,14 @@ int main(int argc, char **argv)
             robot.truck[t].has_calibration = true;
         }
     }
-    if (sim_scenario_parse_file(scenario_path, &scenario, err, sizeof err) != 0) {
-        fprintf(stderr, "odo-sim: %s\n", err);
+    odosim_scenario_t *scenario = odosim_scenario_new();
+    if (scenario == NULL || odosim_scenario_load(scenario, scenario_path, err, sizeof err) != 0) {
+        fprintf(stderr, "odo-sim: %s\n", scenario == NULL ? "out of memory" : err);
+        odosim_scenario_free(scenario);
         return 1;
     }
     if (!seed_given) {
-        seed = scenario.seed;
+        seed = odosim_scenario_seed(scenario);
     }
 
     /* Inputs are never outputs: the robot, the scenario and the block must survive any --out. */
@@ -335,11 +334,12 @@ int main(int argc, char **argv)
     odo_out_dir_t *dir = odo_out_dir_begin(out, "odo-sim", force, &ins, err, sizeof err);
     if (dir == NULL) {
         fprintf(stderr, "odo-sim: %s\n", err);
+        odosim_scenario_free(scenario);
         return 1;
     }
     const int straight = strcmp(experiment, "straight-36m") == 0;
     const int dirs = straight ? 1 : 2;
-    static sim_return_t rets[2 * MAX_RUNS];
+    static odosim_return_t rets[2 * MAX_RUNS];
     size_t n_ret = 0;
     int rc = 0;
     for (int d = 0; d < dirs && rc == 0; ++d) {
@@ -357,18 +357,18 @@ int main(int argc, char **argv)
             } else {
                 fprintf(rf.truth, "t_s,a_x_mm,a_y_mm,a_theta_deg,b_x_mm,b_y_mm,b_theta_deg,alpha_deg,"
                                   "beta_deg,l_mm,events\n");
-                const sim_run_config_t cfg = {
+                const odosim_sil_config_t cfg = {
                     .robot = &robot,
-                    .scenario = &scenario,
+                    .scenario = scenario,
                     .experiment = experiment,
                     .ccw = d,
                     .bumps = (int)bumps,
                     .bump_height_mm = 10.0,
                     .ipec = ipec,
-                    .seed = sim_run_seed(seed, d, k),
+                    .seed = odosim_run_seed(seed, d, k),
                     .run_index = k,
                 };
-                if (sim_run(&cfg, on_tick, &rf, &rets[n_ret], err, sizeof err) != 0) {
+                if (odosim_sil_run(&cfg, on_tick, &rf, &rets[n_ret], err, sizeof err) != 0) {
                     fprintf(stderr, "odo-sim: %s\n", err);
                     rc = -1;
                 } else if (!quiet) {
@@ -386,6 +386,7 @@ int main(int argc, char **argv)
             }
         }
     }
+    odosim_scenario_free(scenario);
     if (rc == 0 && (write_returns(dir, rets, n_ret, straight, err, sizeof err) != 0 ||
                     write_summary(dir, experiment, vehicle_name, (unsigned)runs, seed, rets, n_ret, straight, err,
                                   sizeof err) != 0)) {
@@ -402,8 +403,8 @@ int main(int argc, char **argv)
     }
     {
         if (!quiet) {
-            sim_summary_t s;
-            sim_summarise(rets, n_ret, &s);
+            odosim_summary_t s;
+            odosim_summarise(rets, n_ret, &s);
             fprintf(stderr, "odo-sim: Emax,syst %.1f mm (000 Eq. 3.4), SEM %.1f mm, avg |etheta| %.3f deg -> %s\n",
                     s.emax_syst_mm, s.sem_mm, s.avg_abs_theta_err_deg, out);
         }

@@ -19,8 +19,7 @@
 #include "odo_refcheck.h"
 #include "odo_synth.h"
 #include "replay_bench.h"
-#include "odo_robot.h"
-#include "sil.h"
+#include "odosim/odosim_sil.h"
 #include "trig_accuracy.h"
 
 #define KERNEL_STEPS 20000U
@@ -169,39 +168,42 @@ static double now_s(void)
 static double sim_umbmark_10runs(double *sim_s)
 {
     static sim_robot_t robot;
-    static sim_scenario_t sc;
     char err[256];
     if (sim_robot_default(SIM_VEHICLE_LABMATE, &robot) != 0) {
         return -1.0;
     }
-    sim_scenario_none(&sc);
-    if (sim_scenario_set(&sc, "eb", "value", 1U, 337.0 / 340.0, err, sizeof err) != 0 ||
-        sim_scenario_set(&sc, "ed", "value", 1U, 0.9985, err, sizeof err) != 0 ||
-        sim_scenario_set(&sc, "roughness", NULL, 1U, 0.0, err, sizeof err) != 0) {
-        fprintf(stderr, "odo-bench: %s\n", err);
+    odosim_scenario_t *sc = odosim_scenario_new();
+    if (sc == NULL || odosim_scenario_set(sc, "eb", "value", 1U, 337.0 / 340.0, err, sizeof err) != 0 ||
+        odosim_scenario_set(sc, "ed", "value", 1U, 0.9985, err, sizeof err) != 0 ||
+        odosim_scenario_set(sc, "roughness", NULL, 1U, 0.0, err, sizeof err) != 0) {
+        fprintf(stderr, "odo-bench: %s\n", sc == NULL ? "out of memory" : err);
+        odosim_scenario_free(sc);
         return -1.0;
     }
     *sim_s = 0.0;
     const double t0 = now_s();
     for (int d = 0; d < 2; ++d) {
         for (unsigned k = 0; k < 5U; ++k) {
-            sim_run_config_t cfg = {.robot = &robot,
-                                    .scenario = &sc,
-                                    .experiment = "umbmark",
-                                    .ccw = d,
-                                    .bumps = -1,
-                                    .bump_height_mm = 10.0,
-                                    .seed = 100U + k,
-                                    .run_index = k};
-            sim_return_t ret;
-            if (sim_run(&cfg, NULL, NULL, &ret, err, sizeof err) != 0) {
+            odosim_sil_config_t cfg = {.robot = &robot,
+                                       .scenario = sc,
+                                       .experiment = "umbmark",
+                                       .ccw = d,
+                                       .bumps = -1,
+                                       .bump_height_mm = 10.0,
+                                       .seed = 100U + k,
+                                       .run_index = k};
+            odosim_return_t ret;
+            if (odosim_sil_run(&cfg, NULL, NULL, &ret, err, sizeof err) != 0) {
                 fprintf(stderr, "odo-bench: %s\n", err);
+                odosim_scenario_free(sc);
                 return -1.0;
             }
             *sim_s += ret.t_end_s;
         }
     }
-    return now_s() - t0;
+    const double wall = now_s() - t0;
+    odosim_scenario_free(sc);
+    return wall;
 }
 
 int main(int argc, char **argv)

@@ -24,9 +24,8 @@
 #include <string.h>
 
 #include "calib_core.h"
-#include "effects.h"
 #include "odo_robot.h"
-#include "sil.h"
+#include "odosim/odosim_sil.h"
 
 #define Q30        1073741824.0
 #define SIDE_MM    4000.0 /* host_sim's umbmark square (000 s. 3.5) */
@@ -46,13 +45,13 @@ static double uniform(uint64_t *s, double lo, double hi)
 }
 
 /// `runs` runs each way of the umbmark square; returns in *r (000 Eq. 3.1).
-static int run_umbmark(const sim_robot_t *robot, const sim_scenario_t *sc, unsigned runs, uint64_t seed, returns_t *r,
-                       char *err, size_t errlen)
+static int run_umbmark(const sim_robot_t *robot, const odosim_scenario_t *sc, unsigned runs, uint64_t seed,
+                       returns_t *r, char *err, size_t errlen)
 {
     memset(r, 0, sizeof *r);
     for (int d = 0; d < 2; ++d) {
         for (unsigned k = 0; k < runs; ++k) {
-            const sim_run_config_t cfg = {
+            const odosim_sil_config_t cfg = {
                 .robot = robot,
                 .scenario = sc,
                 .experiment = "umbmark",
@@ -60,11 +59,11 @@ static int run_umbmark(const sim_robot_t *robot, const sim_scenario_t *sc, unsig
                 .bumps = -1,
                 .bump_height_mm = 10.0,
                 .ipec = 0,
-                .seed = sim_run_seed(seed, d, k),
+                .seed = odosim_run_seed(seed, d, k),
                 .run_index = k,
             };
-            sim_return_t ret;
-            if (sim_run(&cfg, NULL, NULL, &ret, err, errlen) != 0) {
+            odosim_return_t ret;
+            if (odosim_sil_run(&cfg, NULL, NULL, &ret, err, errlen) != 0) {
                 return -1;
             }
             const size_t i = r->n[d]++;
@@ -118,9 +117,9 @@ typedef struct {
 } robot_result_t;
 
 /// Calibrate from `r` with params `in_force`, run again; `passes` times. Returns 0 or -1.
-static int calibrate_and_rerun(const sim_robot_t *base, const sim_scenario_t *sc, const returns_t *first, unsigned runs,
-                               uint64_t seed, calib_method_t m, unsigned passes, robot_result_t *rr, char *err,
-                               size_t errlen)
+static int calibrate_and_rerun(const sim_robot_t *base, const odosim_scenario_t *sc, const returns_t *first,
+                               unsigned runs, uint64_t seed, calib_method_t m, unsigned passes, robot_result_t *rr,
+                               char *err, size_t errlen)
 {
     static returns_t r;
     r = *first;
@@ -162,21 +161,21 @@ static double median(double *v, size_t n)
     return n == 0 ? (double)NAN : (n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]));
 }
 
-static int make_scenario(sim_scenario_t *sc, double ed, double eb, double es, int rough, uint64_t seed, char *err,
+static int make_scenario(odosim_scenario_t *sc, double ed, double eb, double es, int rough, uint64_t seed, char *err,
                          size_t errlen)
 {
-    sim_scenario_none(sc);
-    sc->seed = seed;
-    if (sim_scenario_set(sc, "ed", "value", 1U, ed, err, errlen) != 0 ||
-        sim_scenario_set(sc, "eb", "value", 1U, eb, err, errlen) != 0 ||
-        (es != 1.0 && sim_scenario_set(sc, "es", "value", 1U, es, err, errlen) != 0) ||
-        (rough && sim_scenario_set(sc, "roughness", NULL, 1U, 0.0, err, errlen) != 0)) {
+    odosim_scenario_clear(sc);
+    odosim_scenario_set_seed(sc, seed);
+    if (odosim_scenario_set(sc, "ed", "value", 1U, ed, err, errlen) != 0 ||
+        odosim_scenario_set(sc, "eb", "value", 1U, eb, err, errlen) != 0 ||
+        (es != 1.0 && odosim_scenario_set(sc, "es", "value", 1U, es, err, errlen) != 0) ||
+        (rough && odosim_scenario_set(sc, "roughness", NULL, 1U, 0.0, err, errlen) != 0)) {
         return -1;
     }
     return 0;
 }
 
-int calib_acceptance_main(int argc, char **argv)
+static int acceptance(int argc, char **argv, odosim_scenario_t *sc)
 {
     long n_robots = 20, runs = 5;
     uint64_t seed = 1;
@@ -239,7 +238,6 @@ int calib_acceptance_main(int argc, char **argv)
     }
     static robot_result_t res[MAX_ROBOTS];
     static returns_t first;
-    static sim_scenario_t sc;
     uint64_t rng = seed * 0x2545F4914F6CDD1DULL + 1U;
     double nf_ed_max = 0.0, nf_b_max = 0.0;
     for (long i = 0; i < n_robots; ++i) {
@@ -247,11 +245,11 @@ int calib_acceptance_main(int argc, char **argv)
         rr->ed_true = uniform(&rng, 0.995, 1.005);
         rr->b_true = uniform(&rng, 0.97, 1.03) * 340.0;
         const uint64_t rseed = splitmix(&rng);
-        if (make_scenario(&sc, rr->ed_true, rr->b_true / 340.0, 1.0, 1, rseed, err, sizeof err) != 0 ||
-            run_umbmark(&base, &sc, (unsigned)runs, rseed, &first, err, sizeof err) != 0 ||
+        if (make_scenario(sc, rr->ed_true, rr->b_true / 340.0, 1.0, 1, rseed, err, sizeof err) != 0 ||
+            run_umbmark(&base, sc, (unsigned)runs, rseed, &first, err, sizeof err) != 0 ||
             stats_of(&first, &rr->before, err, sizeof err) != 0 ||
-            calibrate_and_rerun(&base, &sc, &first, (unsigned)runs, rseed, CALIB_EXACT, 1, rr, err, sizeof err) != 0 ||
-            calibrate_and_rerun(&base, &sc, &first, (unsigned)runs, rseed, CALIB_PAPER, 1, rr, err, sizeof err) != 0) {
+            calibrate_and_rerun(&base, sc, &first, (unsigned)runs, rseed, CALIB_EXACT, 1, rr, err, sizeof err) != 0 ||
+            calibrate_and_rerun(&base, sc, &first, (unsigned)runs, rseed, CALIB_PAPER, 1, rr, err, sizeof err) != 0) {
             fprintf(stderr, "odo-calib acceptance: robot %ld: %s\n", i + 1, err);
             return 1;
         }
@@ -259,8 +257,8 @@ int calib_acceptance_main(int argc, char **argv)
         static returns_t nf;
         calib_result_t c;
         odo_params_t in_force;
-        if (make_scenario(&sc, rr->ed_true, rr->b_true / 340.0, 1.0, 0, rseed, err, sizeof err) != 0 ||
-            run_umbmark(&base, &sc, 2, rseed, &nf, err, sizeof err) != 0 ||
+        if (make_scenario(sc, rr->ed_true, rr->b_true / 340.0, 1.0, 0, rseed, err, sizeof err) != 0 ||
+            run_umbmark(&base, sc, 2, rseed, &nf, err, sizeof err) != 0 ||
             sim_robot_to_params(&base, &in_force, err, sizeof err) != 0 ||
             calib_umbmark(&nf, SIDE_MM, &in_force, CALIB_EXACT, &c, err, sizeof err) != 0) {
             fprintf(stderr, "odo-calib acceptance: robot %ld (noise-free): %s\n", i + 1, err);
@@ -319,12 +317,12 @@ int calib_acceptance_main(int argc, char **argv)
             tp[k].ed = dr / dl;
             tp[k].es = dn / ((dl + dr) / 2.0);
             const uint64_t tseed = seed * 1000U + 7U + (uint64_t)k;
-            if (make_scenario(&sc, tp[k].ed, eb0, tp[k].es, 1, tseed, err, sizeof err) != 0 ||
-                run_umbmark(&base, &sc, (unsigned)runs, tseed, &first, err, sizeof err) != 0 ||
+            if (make_scenario(sc, tp[k].ed, eb0, tp[k].es, 1, tseed, err, sizeof err) != 0 ||
+                run_umbmark(&base, sc, (unsigned)runs, tseed, &first, err, sizeof err) != 0 ||
                 stats_of(&first, &tp[k].before, err, sizeof err) != 0 ||
-                calibrate_and_rerun(&base, &sc, &first, (unsigned)runs, tseed, CALIB_EXACT, 2, &tp[k].rr, err,
+                calibrate_and_rerun(&base, sc, &first, (unsigned)runs, tseed, CALIB_EXACT, 2, &tp[k].rr, err,
                                     sizeof err) != 0 ||
-                calibrate_and_rerun(&base, &sc, &first, (unsigned)runs, tseed, CALIB_PAPER, 2, &tp[k].rr, err,
+                calibrate_and_rerun(&base, sc, &first, (unsigned)runs, tseed, CALIB_PAPER, 2, &tp[k].rr, err,
                                     sizeof err) != 0) {
                 fprintf(stderr, "odo-calib acceptance: %s: %s\n", tp[k].name, err);
                 return 1;
@@ -400,4 +398,16 @@ int calib_acceptance_main(int argc, char **argv)
         printf("\ntargets %s\n", pass ? "met" : "NOT met");
     }
     return check && !pass ? 1 : 0;
+}
+
+int calib_acceptance_main(int argc, char **argv)
+{
+    odosim_scenario_t *sc = odosim_scenario_new();
+    if (sc == NULL) {
+        fprintf(stderr, "odo-calib acceptance: out of memory\n");
+        return 1;
+    }
+    const int rc = acceptance(argc, argv, sc);
+    odosim_scenario_free(sc);
+    return rc;
 }

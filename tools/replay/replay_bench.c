@@ -19,7 +19,7 @@
 #include "odo/odo_can.h"
 #include "replay.h"
 #include "odo_robot.h"
-#include "sil.h"
+#include "odosim/odosim_sil.h"
 
 #define BENCH_TICKS 90000UL /* one hour at 40 ms */
 
@@ -38,7 +38,7 @@ static void put(gen_t *g, uint64_t t_us, const odo_can_frame_t *f)
     g->io_error |= fwrite(line, 1U, n, g->f) != n;
 }
 
-static void gen_tick(void *user, const sim_tick_t *tk)
+static void gen_tick(void *user, const odosim_tick_t *tk)
 {
     gen_t *g = user;
     const odo_tick_input_t *in = tk->input;
@@ -74,15 +74,13 @@ static void gen_tick(void *user, const sim_tick_t *tk)
     g->tick++;
 }
 
-static int make_log(const char *path)
+static int make_log_with(const char *path, const odosim_scenario_t *sc)
 {
     static sim_robot_t robot;
-    static sim_scenario_t sc;
     char err[256], tmp[600];
     if (sim_robot_default(SIM_VEHICLE_CLAPPER, &robot) != 0) {
         return -1;
     }
-    sim_scenario_none(&sc);
     snprintf(tmp, sizeof tmp, "%s.tmp.%ld", path, (long)getpid());
     gen_t g;
     memset(&g, 0, sizeof g);
@@ -92,17 +90,17 @@ static int make_log(const char *path)
         return -1;
     }
     for (unsigned run = 0; g.tick < BENCH_TICKS; ++run) {
-        sim_run_config_t cfg = {.robot = &robot,
-                                .scenario = &sc,
-                                .experiment = "straight-36m",
-                                .ccw = 0,
-                                .bumps = -1,
-                                .bump_height_mm = 10.0,
-                                .ipec = 0,
-                                .seed = 1000U + run,
-                                .run_index = 0};
-        sim_return_t ret;
-        if (sim_run(&cfg, gen_tick, &g, &ret, err, sizeof err) != 0) {
+        odosim_sil_config_t cfg = {.robot = &robot,
+                                   .scenario = sc,
+                                   .experiment = "straight-36m",
+                                   .ccw = 0,
+                                   .bumps = -1,
+                                   .bump_height_mm = 10.0,
+                                   .ipec = 0,
+                                   .seed = 1000U + run,
+                                   .run_index = 0};
+        odosim_return_t ret;
+        if (odosim_sil_run(&cfg, gen_tick, &g, &ret, err, sizeof err) != 0) {
             fprintf(stderr, "odo-bench: %s\n", err);
             fclose(g.f);
             remove(tmp);
@@ -120,6 +118,19 @@ static int make_log(const char *path)
         return -1;
     }
     return 0;
+}
+
+/// make_log_with on a scenario with no effects.
+static int make_log(const char *path)
+{
+    odosim_scenario_t *sc = odosim_scenario_new();
+    if (sc == NULL) {
+        fprintf(stderr, "odo-bench: out of memory\n");
+        return -1;
+    }
+    const int rc = make_log_with(path, sc);
+    odosim_scenario_free(sc);
+    return rc;
 }
 
 static double now_s(void)
