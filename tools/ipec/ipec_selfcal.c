@@ -7,7 +7,7 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "ipec_tool.h"
+#include "ipec_selfcal.h"
 #include "odo/odo_selfcal.h"
 #include "odo_params_json.h"
 
@@ -60,7 +60,7 @@ typedef struct {
     double corr_deg[ODO_TRUCKS];     ///< sum C
 } sc_ctx_t;
 
-static void sc_tick(void *user, const sim_tick_t *tk)
+static void sc_tick(void *user, const odosim_tick_t *tk)
 {
     sc_ctx_t *c = user;
     const odo_tick_output_t *o = tk->output;
@@ -82,7 +82,7 @@ static double one_sided_deg(const odo_selfcal_truck_t *t)
     return fabs(ipec_bam_deg(t->straight_corr)) + fabs(ipec_bam_deg(t->turn_corr));
 }
 
-static int selfcal_runs(const sim_robot_t *robot, const sim_scenario_t *sc, const char *exp, unsigned runs, int ipec,
+static int selfcal_runs(const sim_robot_t *robot, const odosim_scenario_t *sc, const char *exp, unsigned runs, int ipec,
                         uint64_t seed, sc_ctx_t *ctx)
 {
     char err[256];
@@ -94,7 +94,7 @@ static int selfcal_runs(const sim_robot_t *robot, const sim_scenario_t *sc, cons
     }
     for (int d = 0; d < 2; ++d) {
         for (unsigned k = 0; k < runs; ++k) {
-            sim_return_t ret;
+            odosim_return_t ret;
             if (ipec_run(robot, sc, exp, d, 0, ipec, seed, k, sc_tick, ctx, &ret) != 0) {
                 return -1;
             }
@@ -103,7 +103,7 @@ static int selfcal_runs(const sim_robot_t *robot, const sim_scenario_t *sc, cons
     return 0;
 }
 
-int ipec_selfcal(const sim_robot_t *robot, const sim_scenario_t *sc, const char *exp, unsigned runs, int ipec,
+int ipec_selfcal(const sim_robot_t *robot, const odosim_scenario_t *sc, const char *exp, unsigned runs, int ipec,
                  uint64_t seed, ipec_selfcal_t *out)
 {
     static sc_ctx_t before, after;
@@ -149,7 +149,7 @@ typedef struct {
 
 /// Straight-36m outbound leg: the error (truth - firmware) of truck A at the far reference mark,
 /// where the vehicle stops before the return (the firmware's x is largest there).
-static void far_tick(void *user, const sim_tick_t *tk)
+static void far_tick(void *user, const odosim_tick_t *tk)
 {
     far_t *f = user;
     const odo_pose_t *p = &tk->output->pose[0];
@@ -163,14 +163,14 @@ static void far_tick(void *user, const sim_tick_t *tk)
 
 /// The symptoms of one parameter set: rotary -> (e_theta, e_y / 100 mm) at the far mark;
 /// link -> the return heading error of one UMBmark square cw and one ccw (four rigid 90 deg turns).
-static int measure(const sim_robot_t *base, const sim_scenario_t *sc, const odo_params_t *p, int link, double m[2])
+static int measure(const sim_robot_t *base, const odosim_scenario_t *sc, const odo_params_t *p, int link, double m[2])
 {
     static sim_robot_t r;
     r = *base;
     ipec_apply_params(&r, p);
     if (!link) {
         far_t f = {-1e18, 0, 0};
-        sim_return_t ret;
+        odosim_return_t ret;
         if (ipec_run(&r, sc, "straight-36m", 0, 0, 2, 1U, 0U, far_tick, &f, &ret) != 0) {
             return -1;
         }
@@ -179,7 +179,7 @@ static int measure(const sim_robot_t *base, const sim_scenario_t *sc, const odo_
         return 0;
     }
     for (int d = 0; d < 2; ++d) {
-        sim_return_t ret;
+        odosim_return_t ret;
         if (ipec_run(&r, sc, "umbmark", d, 0, 2, 1U, 0U, NULL, NULL, &ret) != 0) {
             return -1;
         }
@@ -201,7 +201,7 @@ typedef struct {
 /// A code that changed since the last tick was just crossed by the motion: over a sweep the true
 /// angle is uniform within the codes, so code centre - true angle averages to the bias (a held
 /// code would leave an unknown offset of up to half a step). l: every tick (0.1 mm resolution).
-static void bay_tick(void *user, const sim_tick_t *tk)
+static void bay_tick(void *user, const odosim_tick_t *tk)
 {
     bay_t *b = user;
     const odo_link_input_t *in = &tk->input->link;
@@ -227,7 +227,7 @@ static void bay_tick(void *user, const sim_tick_t *tk)
     b->last_b = in->beta_bam16;
 }
 
-int ipec_selfcal_link(const sim_robot_t *robot, const sim_scenario_t *sc, const odo_params_t *start,
+int ipec_selfcal_link(const sim_robot_t *robot, const odosim_scenario_t *sc, const odo_params_t *start,
                       ipec_selfcal_link_t *out)
 {
     memset(out, 0, sizeof *out);
@@ -245,7 +245,7 @@ int ipec_selfcal_link(const sim_robot_t *robot, const sim_scenario_t *sc, const 
     /* One UMBmark square each way: the spins sweep alpha and beta through 90 deg and back. */
     for (int d = 0; d < 2; ++d) {
         b.have_last = false;
-        sim_return_t ret;
+        odosim_return_t ret;
         if (ipec_run(&r, sc, "umbmark", d, 0, 2, 1U, 0U, bay_tick, &b, &ret) != 0) {
             return -1;
         }
@@ -280,7 +280,7 @@ int ipec_selfcal_link(const sim_robot_t *robot, const sim_scenario_t *sc, const 
  * CLI
  * ------------------------------------------------------------------------------------------- */
 static int load_start(const char *vehicle, const char *robot_path, const char *scenario, const char *params,
-                      sim_robot_t *robot, sim_scenario_t *sc, odo_params_t *p)
+                      sim_robot_t *robot, odosim_scenario_t *sc, odo_params_t *p)
 {
     char err[512];
     if (ipec_load(vehicle, robot_path, scenario, robot, sc) != 0) {
@@ -315,6 +315,69 @@ static int load_start(const char *vehicle, const char *robot_path, const char *s
         fprintf(stderr, "odo-ipec: %s\n", err);
         return -1;
     }
+    return 0;
+}
+
+/// The command's work after parsing: load, begin the output, run, write P.json, print JSON.
+static int selfcal_cmd(int link, const char *robot_path, const char *scenario, const char *params, const char *out,
+                       const char *exp, long runs, long seed, int ipec, odosim_scenario_t *sc)
+{
+    static sim_robot_t robot;
+    odo_params_t start;
+    if (load_start("clapper", robot_path, scenario, params, &robot, sc, &start) != 0) {
+        return 1;
+    }
+    /* The output is checked (and its temp made) before the runs: an input is never overwritten. */
+    char err[4096 + 256];
+    odo_out_inputs_t ins;
+    odo_out_inputs_init(&ins);
+    (void)odo_out_inputs_add(&ins, robot_path, err, sizeof err);
+    (void)odo_out_inputs_add(&ins, scenario, err, sizeof err);
+    (void)odo_out_inputs_add(&ins, params, err, sizeof err);
+    odo_out_file_t of;
+    if (odo_out_file_begin(&of, out, &ins, err, sizeof err) != 0) {
+        fprintf(stderr, "odo-ipec: %s\n", err);
+        return 1;
+    }
+    if (!link) {
+        static ipec_selfcal_t r;
+        if (ipec_selfcal(&robot, sc, exp, (unsigned)runs, ipec, (uint64_t)seed, &r) != 0) {
+            odo_out_file_abort(&of);
+            return 1;
+        }
+        if (ipec_write_params(&of, &r.params) != 0) {
+            return 1;
+        }
+        printf("{\n  \"experiment\": \"%s\", \"runs_per_direction\": %ld, \"params\": \"%s\",\n  \"truck\": [\n", exp,
+               runs, out);
+        for (unsigned i = 0; i < ODO_TRUCKS; ++i) {
+            printf(
+                "    {\"ed\": %.6f, \"eb\": %.6f, \"straight_m\": %.2f, \"turn_deg\": %.1f, "
+                "\"corr_deg_per_m\": %.5f, \"corr_deg_per_turn\": %.4f, \"one_sided_corr_deg_before\": %.3f, "
+                "\"one_sided_corr_deg_after\": %.3f, \"abs_corr_deg_before\": %.3f, \"abs_corr_deg_after\": %.3f}%s\n",
+                r.ed[i], r.eb[i], r.straight_m[i], r.turn_deg[i], r.corr_deg_per_m[i], r.corr_deg_per_turn[i],
+                r.one_sided_before_deg[i], r.one_sided_after_deg[i], r.abs_before_deg[i], r.abs_after_deg[i],
+                i + 1U < ODO_TRUCKS ? "," : "");
+        }
+        printf("  ]\n}\n");
+        return 0;
+    }
+    static ipec_selfcal_link_t r;
+    if (ipec_selfcal_link(&robot, sc, &start, &r) != 0) {
+        odo_out_file_abort(&of);
+        return 1;
+    }
+    if (ipec_write_params(&of, &r.params) != 0) {
+        return 1;
+    }
+    printf("{\n  \"params\": \"%s\",\n  \"alpha_bias_deg\": %.4f, \"beta_bias_deg\": %.4f, \"length_bias_mm\": %.4f,\n"
+           "  \"far_mark_before\": {\"etheta_deg\": %.4f, \"ey_mm\": %.2f},\n"
+           "  \"far_mark_after\": {\"etheta_deg\": %.4f, \"ey_mm\": %.2f},\n"
+           "  \"umbmark_etheta_before_deg\": {\"cw\": %.4f, \"ccw\": %.4f},\n"
+           "  \"umbmark_etheta_after_deg\": {\"cw\": %.4f, \"ccw\": %.4f},\n  \"sweep_ticks\": [%u, %u]\n}\n",
+           out, r.alpha_bias_deg, r.beta_bias_deg, r.length_bias_mm, r.rotary_before[0], r.rotary_before[1] * 100.0,
+           r.rotary_after[0], r.rotary_after[1] * 100.0, r.link_before[0], r.link_before[1], r.link_after[0],
+           r.link_after[1], r.sweep_ticks[0], r.sweep_ticks[1]);
     return 0;
 }
 
@@ -363,62 +426,12 @@ int ipec_cmd_selfcal(int argc, char **argv, int link)
         fprintf(stderr, "odo-ipec %s: --scenario and --out are required\n", link ? "selfcal-link" : "selfcal");
         return 2;
     }
-    static sim_robot_t robot;
-    static sim_scenario_t sc;
-    odo_params_t start;
-    if (load_start("clapper", robot_path, scenario, params, &robot, &sc, &start) != 0) {
+    odosim_scenario_t *sc = odosim_scenario_new();
+    if (sc == NULL) {
+        fprintf(stderr, "odo-ipec: out of memory\n");
         return 1;
     }
-    /* The output is checked (and its temp made) before the runs: an input is never overwritten. */
-    char err[4096 + 256];
-    odo_out_inputs_t ins;
-    odo_out_inputs_init(&ins);
-    (void)odo_out_inputs_add(&ins, robot_path, err, sizeof err);
-    (void)odo_out_inputs_add(&ins, scenario, err, sizeof err);
-    (void)odo_out_inputs_add(&ins, params, err, sizeof err);
-    odo_out_file_t of;
-    if (odo_out_file_begin(&of, out, &ins, err, sizeof err) != 0) {
-        fprintf(stderr, "odo-ipec: %s\n", err);
-        return 1;
-    }
-    if (!link) {
-        static ipec_selfcal_t r;
-        if (ipec_selfcal(&robot, &sc, exp, (unsigned)runs, ipec, (uint64_t)seed, &r) != 0) {
-            odo_out_file_abort(&of);
-            return 1;
-        }
-        if (ipec_write_params(&of, &r.params) != 0) {
-            return 1;
-        }
-        printf("{\n  \"experiment\": \"%s\", \"runs_per_direction\": %ld, \"params\": \"%s\",\n  \"truck\": [\n", exp,
-               runs, out);
-        for (unsigned i = 0; i < ODO_TRUCKS; ++i) {
-            printf(
-                "    {\"ed\": %.6f, \"eb\": %.6f, \"straight_m\": %.2f, \"turn_deg\": %.1f, "
-                "\"corr_deg_per_m\": %.5f, \"corr_deg_per_turn\": %.4f, \"one_sided_corr_deg_before\": %.3f, "
-                "\"one_sided_corr_deg_after\": %.3f, \"abs_corr_deg_before\": %.3f, \"abs_corr_deg_after\": %.3f}%s\n",
-                r.ed[i], r.eb[i], r.straight_m[i], r.turn_deg[i], r.corr_deg_per_m[i], r.corr_deg_per_turn[i],
-                r.one_sided_before_deg[i], r.one_sided_after_deg[i], r.abs_before_deg[i], r.abs_after_deg[i],
-                i + 1U < ODO_TRUCKS ? "," : "");
-        }
-        printf("  ]\n}\n");
-        return 0;
-    }
-    static ipec_selfcal_link_t r;
-    if (ipec_selfcal_link(&robot, &sc, &start, &r) != 0) {
-        odo_out_file_abort(&of);
-        return 1;
-    }
-    if (ipec_write_params(&of, &r.params) != 0) {
-        return 1;
-    }
-    printf("{\n  \"params\": \"%s\",\n  \"alpha_bias_deg\": %.4f, \"beta_bias_deg\": %.4f, \"length_bias_mm\": %.4f,\n"
-           "  \"far_mark_before\": {\"etheta_deg\": %.4f, \"ey_mm\": %.2f},\n"
-           "  \"far_mark_after\": {\"etheta_deg\": %.4f, \"ey_mm\": %.2f},\n"
-           "  \"umbmark_etheta_before_deg\": {\"cw\": %.4f, \"ccw\": %.4f},\n"
-           "  \"umbmark_etheta_after_deg\": {\"cw\": %.4f, \"ccw\": %.4f},\n  \"sweep_ticks\": [%u, %u]\n}\n",
-           out, r.alpha_bias_deg, r.beta_bias_deg, r.length_bias_mm, r.rotary_before[0], r.rotary_before[1] * 100.0,
-           r.rotary_after[0], r.rotary_after[1] * 100.0, r.link_before[0], r.link_before[1], r.link_after[0],
-           r.link_after[1], r.sweep_ticks[0], r.sweep_ticks[1]);
-    return 0;
+    const int rc = selfcal_cmd(link, robot_path, scenario, params, out, exp, runs, seed, ipec, sc);
+    odosim_scenario_free(sc);
+    return rc;
 }

@@ -1,6 +1,6 @@
 /// odo-ipec: IPEC's acceptance figures and per-tick traces
 /// (tools/ipec/README.md). Every figure is computed here by re-running the software-in-the-loop
-/// simulator (host_sim/run/sil.h) with the firmware's own IPEC in the loop; nothing is timed.
+/// simulator (host_sim/include/odosim/odosim_sil.h) with the firmware's own IPEC in the loop; nothing is timed.
 #include <errno.h>
 #include <limits.h>
 #include <math.h>
@@ -9,9 +9,10 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "odo_data_dir.h"
+#include "ipec_goals.h"
+#include "ipec_selfcal.h"
+#include "ipec_sim.h"
 #include "odo_cli.h"
-#include "ipec_tool.h"
 
 static void usage(FILE *f)
 {
@@ -40,75 +41,12 @@ static void usage(FILE *f)
             "Robots default to host_sim/robots/<vehicle>.json; scenarios to host_sim/scenarios/none.json.\n");
 }
 
-/* ---------------------------------------------------------------------------------------------
- * Shared helpers (ipec_tool.h)
- * ------------------------------------------------------------------------------------------- */
-static char g_src[PATH_MAX - 256];
-
-const char *ipec_src_dir(void)
-{
-    if (g_src[0] == '\0') {
-        (void)odo_data_path(".", g_src, sizeof g_src); /* "" if too long: paths then fail to open */
-    }
-    return g_src;
-}
-
-int ipec_load(const char *vehicle, const char *robot_path, const char *scenario_path, sim_robot_t *robot,
-              sim_scenario_t *sc)
-{
-    char path[PATH_MAX];
-    char err[512];
-    if (robot_path == NULL) {
-        snprintf(path, sizeof path, "%s/host_sim/robots/%s.json", ipec_src_dir(), vehicle);
-        robot_path = path;
-    }
-    if (sim_robot_parse_file(robot_path, robot, err, sizeof err) != 0) {
-        fprintf(stderr, "odo-ipec: %s\n", err);
-        return -1;
-    }
-    if (scenario_path == NULL) {
-        sim_scenario_none(sc);
-        return 0;
-    }
-    if (sim_scenario_parse_file(scenario_path, sc, err, sizeof err) != 0) {
-        fprintf(stderr, "odo-ipec: %s\n", err);
-        return -1;
-    }
-    return 0;
-}
-
-int ipec_run(const sim_robot_t *robot, const sim_scenario_t *sc, const char *experiment, int ccw, int bumps, int ipec,
-             uint64_t seed, unsigned run, sim_tick_fn fn, void *user, sim_return_t *ret)
-{
-    char err[512];
-    const sim_run_config_t cfg = {
-        .robot = robot,
-        .scenario = sc,
-        .experiment = experiment,
-        .ccw = ccw,
-        .bumps = bumps,
-        .bump_height_mm = 10.0,
-        .ipec = ipec,
-        .seed = sim_run_seed(seed, ccw, run),
-        .run_index = run,
-    };
-    if (sim_run(&cfg, fn, user, ret, err, sizeof err) != 0) {
-        fprintf(stderr, "odo-ipec: %s\n", err);
-        return -1;
-    }
-    return 0;
-}
-
-double ipec_bam_deg(int64_t bam) { return (double)bam * (360.0 / 4294967296.0); }
-
 static double wrap_deg(double d) { return remainder(d, 360.0); }
-
-double ipec_est_theta_deg(const odo_pose_t *p) { return ipec_bam_deg((int32_t)odo_heading_bam(p)); }
 
 /* ---------------------------------------------------------------------------------------------
  * trace
  * ------------------------------------------------------------------------------------------- */
-static void trace_tick(void *user, const sim_tick_t *tk)
+static void trace_tick(void *user, const odosim_tick_t *tk)
 {
     (void)user;
     const odo_tick_output_t *o = tk->output;
@@ -179,7 +117,7 @@ static int cmd_trace(int argc, char **argv)
                 return 2;
             }
         } else if (strcmp(a, "--bumps") == 0) {
-            if (parse_long(a, v, 0, SIM_PROGRAM_MAX_BUMPS, &bumps) != 0) {
+            if (parse_long(a, v, 0, ODOSIM_MAX_BUMPS, &bumps) != 0) {
                 return 2;
             }
         } else if (strcmp(a, "--run") == 0) {
@@ -200,15 +138,18 @@ static int cmd_trace(int argc, char **argv)
         return 2;
     }
     static sim_robot_t robot;
-    static sim_scenario_t sc;
-    if (ipec_load(vehicle, robot_path, scenario, &robot, &sc) != 0) {
+    odosim_scenario_t *sc = odosim_scenario_new();
+    if (sc == NULL || ipec_load(vehicle, robot_path, scenario, &robot, sc) != 0) {
+        odosim_scenario_free(sc);
         return 1;
     }
     printf("t_s,a_x_mm,a_y_mm,a_theta_deg,a_err_deg,b_err_deg,alpha_deg,beta_deg,dtheta_a_deg,dtheta_b_deg,"
            "innov_a_deg,innov_b_deg,alpha_code_deg,l_mm,faults,bump_events\n");
-    sim_return_t ret;
-    if (ipec_run(&robot, &sc, experiment, ccw, (int)bumps, ipec, (uint64_t)seed, (unsigned)run, trace_tick, NULL,
-                 &ret) != 0) {
+    odosim_return_t ret;
+    const int rc =
+        ipec_run(&robot, sc, experiment, ccw, (int)bumps, ipec, (uint64_t)seed, (unsigned)run, trace_tick, NULL, &ret);
+    odosim_scenario_free(sc);
+    if (rc != 0) {
         return 1;
     }
     fprintf(stderr, "odo-ipec: return ex %.1f mm ey %.1f mm etheta %.3f deg\n", ret.ex_mm, ret.ey_mm, ret.etheta_deg);
