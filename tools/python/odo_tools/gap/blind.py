@@ -325,8 +325,9 @@ def guard(forbidden: str) -> None:
 
 def _diag(job: tuple) -> dict:
     real, mode = job
-    from .diagnose import diagnose, write_report
+    from .diagnose import diagnose
     from .errors import GapInputError
+    from .report import write_report
 
     try:
         # the instrument the returns were measured with is part of the recording, not the key

@@ -61,7 +61,8 @@ def main(argv: list[str] | None = None) -> int:
                     acc = ()
                 if len(acc) != 2 or not all(math.isfinite(x) and x > 0 for x in acc):
                     ap.error("--return-accuracy: expected MM,DEG, two positive numbers")
-            from .diagnose import diagnose, write_report
+            from .diagnose import diagnose
+            from .report import write_report
 
             t0 = time.perf_counter()
             rep = diagnose(a.real, a.robot, a.holdout, a.seed, a.mode, _progress(a.quiet), acc)

@@ -3,10 +3,7 @@
 from __future__ import annotations
 
 import itertools
-import json
 import math
-import os
-import shutil
 import time
 from pathlib import Path
 
@@ -477,33 +474,6 @@ def where_analysis(items, prs, f: Fit | None, chans, sigma) -> list[dict]:
             ]
         out.append(entry)
     return out
-
-
-def write_report(rep: dict, out: str | Path) -> None:
-    """Everything into OUT.tmp.<pid>, then renamed into place: never a partial report."""
-    from .plots import plot_report
-
-    out = Path(out)
-    tmp = out.with_name(out.name + f".tmp.{os.getpid()}")
-    if tmp.exists():
-        shutil.rmtree(tmp)
-    tmp.mkdir(parents=True)
-    try:
-        extra = rep.pop("_plot", None)
-        (tmp / "report.json").write_text(json.dumps(rep, indent=2) + "\n")
-        (tmp / "report.md").write_text(markdown(rep))
-        if extra is not None:
-            plot_report(rep, extra, tmp)
-        if out.exists():
-            old = out.with_name(out.name + f".old.{os.getpid()}")
-            out.rename(old)
-            tmp.rename(out)
-            shutil.rmtree(old)
-        else:
-            tmp.rename(out)
-    except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
-        raise
 
 
 def markdown(rep: dict) -> str:

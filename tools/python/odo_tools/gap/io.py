@@ -9,7 +9,6 @@ from __future__ import annotations
 import csv
 import json
 import math
-import os
 import re
 from dataclasses import dataclass, field
 from functools import lru_cache
@@ -18,23 +17,12 @@ from pathlib import Path
 import numpy as np
 
 from .errors import GapInputError
+from .paths import source_dir
 
 ID_WHEEL = {0x110: 0, 0x111: 1}
 ID_ROTARY = 0x120
 ID_LINEAR = 0x121
 RUN_RE = re.compile(r"^run-(?P<dir>[a-z]+)-(?P<idx>\d+)\.log$")
-
-
-def source_dir() -> Path:
-    """The repository root (ODO_SOURCE_DIR, else found from this file)."""
-    env = os.environ.get("ODO_SOURCE_DIR")
-    if env:
-        return Path(env)
-    here = Path(__file__).resolve()
-    for p in here.parents:
-        if (p / "can" / "odometry.dbc").is_file():
-            return p
-    raise GapInputError(here, "cannot find the repository (can/odometry.dbc); set ODO_SOURCE_DIR")
 
 
 @dataclass(frozen=True)

@@ -10,7 +10,7 @@ from functools import lru_cache
 from pathlib import Path
 
 from .errors import GapInputError
-from .io import source_dir
+from .paths import source_dir
 
 
 class RowEx(C.Structure):
