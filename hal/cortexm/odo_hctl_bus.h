@@ -8,7 +8,7 @@
 ///      latches the address on ALE's falling edge;
 ///   2. D0-D7 as inputs; /OE low; wait `settle_loops`; read IDR[7:0]; /OE high; /CS high.
 /// Position: R14H (LSB, which latches the upper bytes), R13H, R12H, in that order: the latch
-/// order of the chip and of the simulator's emulator (host_sim/src/hctl1100.h), so the three
+/// order of the chip and of the simulator's emulator (hal/sim/hctl1100.h), so the three
 /// bytes belong to one count even while the wheel turns. The 24-bit count wraps; samples carry
 /// bits = 24.
 ///

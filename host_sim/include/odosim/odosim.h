@@ -6,6 +6,8 @@
 /// C ABI, plain types only, so Python can call it through ctypes. Thread safety: a setup may be
 /// shared by concurrent odosim_run calls (it is only read); everything else is per call.
 /// Errors: functions return 0 / non-NULL on success, and -1 / NULL with a message in err.
+/// C programs built in this tree that need more (a per-tick callback with the firmware's own
+/// tick input and output, scenarios built in memory) use odosim_sil.h beside this header.
 #ifndef ODOSIM_H
 #define ODOSIM_H
 
