@@ -12,7 +12,7 @@ Two layouts, one rule each:
   .deb's odo-sim was installed under (PREFIX/bin/odo-sim on PATH -> PREFIX/lib), the
   directories of LD_LIBRARY_PATH, this environment's prefix, /usr/local/lib and /usr/lib.
 
-The gap modules take both locations from ODO_SOURCE_DIR and ODO_BUILD_DIR (gap/io.py
+The gap modules take both locations from ODO_SOURCE_DIR and ODO_BUILD_DIR (gap/paths.py
 source_dir, gap/simlib.py lib_path). `export_for_gap` sets those two for an installed package
 when the user has not, so an installed odo-gap or odo-import finds what the checkout would give
 it; in a checkout it sets nothing.
