@@ -15,11 +15,16 @@ checks, on that graph:
   - host_sim's internals (PRIVATE: host_sim/src, host_sim/run) are included only from inside
     them: host_sim/cli, host_sim/include and every tool go through host_sim/include.
 
+Objects (with a build tree): within each CMake target, an object that uses a symbol another of
+its objects defines depends on it (`nm`); no cycles, so a command never needs the file with main()
+for a helper (issue 17: tools/ipec, tools/calib).
+
 Python: every module of tools/python/odo_tools is parsed with `ast`; every import statement,
 including those inside functions, adds an edge to the odo_tools module it names (`from .pkg
 import name` names pkg.name when that is a module, else pkg). No cycles.
 
-  layers.py SRC      print the violations, exit 1 if there are any (0 and a summary otherwise)
+  layers.py SRC [--build DIR]   print the violations, exit 1 if there are any (0 and a summary
+                                otherwise); --build adds the object check over DIR's targets
 """
 
 from __future__ import annotations
@@ -28,6 +33,7 @@ import argparse
 import ast
 import os
 import re
+import subprocess
 import sys
 from collections.abc import Iterable, Mapping
 from pathlib import Path
@@ -229,6 +235,62 @@ def check_python(graph: Graph) -> list[str]:
     return ["import cycle: " + " <-> ".join(c) for c in cycles(graph)]
 
 
+def _nm(args: list[str], objs: list[Path]) -> dict[str, set[str]]:
+    """{object path: symbols} from `nm -A ARGS OBJS` (one call per batch of objects)."""
+    out: dict[str, set[str]] = {str(o): set() for o in objs}
+    for i in range(0, len(objs), 200):
+        batch = [str(o) for o in objs[i : i + 200]]
+        text = subprocess.run(
+            ["nm", "-A", *args, *batch], capture_output=True, text=True, check=True
+        ).stdout
+        for line in text.splitlines():
+            path, _, rest = line.partition(":")
+            fields = rest.split()
+            if path in out and fields:
+                out[path].add(fields[-1])
+    return out
+
+
+def object_graphs(build: Path) -> dict[str, dict[str, set[str]]]:
+    """{target folder: {object: objects of the same target whose symbols it uses}} for every
+    CMake target of the build tree at `build` (nested build trees, with their own CMakeCache.txt,
+    are left out)."""
+    nested = {p.parent for p in build.rglob("CMakeCache.txt") if p.parent != build}
+    targets: dict[Path, list[Path]] = {}
+    for o in sorted(build.rglob("*.o")):
+        d = next((p for p in o.parents if p.suffix == ".dir"), None)
+        if d is None or any(n in o.parents for n in nested):
+            continue
+        targets.setdefault(d, []).append(o)
+    targets = {d: objs for d, objs in targets.items() if len(objs) > 1}
+    objs = [o for v in targets.values() for o in v]
+    if not objs:
+        return {}
+    defined = _nm(["-g", "--defined-only"], objs)
+    used = _nm(["-u"], objs)
+    graphs = {}
+    for d, tobjs in targets.items():
+        owner = {sym: str(o) for o in tobjs for sym in defined[str(o)]}
+        rel = {str(o): o.relative_to(d).as_posix() for o in tobjs}
+        graphs[d.relative_to(build).as_posix()] = {
+            rel[str(o)]: {
+                rel[owner[sym]]
+                for sym in used[str(o)]
+                if sym in owner and owner[sym] != str(o)
+            }
+            for o in tobjs
+        }
+    return graphs
+
+
+def check_objects(graphs: Mapping[str, Graph]) -> list[str]:
+    return [
+        f"object cycle in {t}: " + " <-> ".join(c)
+        for t, g in sorted(graphs.items())
+        for c in cycles(g)
+    ]
+
+
 def check_tree(src: Path) -> tuple[list[str], dict[str, int]]:
     """All violations in a source tree, and counts of what was read."""
     cg, problems = c_graph(src)
@@ -247,8 +309,13 @@ def main(argv: list[str] | None = None) -> int:
         description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
     )
     ap.add_argument("src", type=Path, help="the repository root")
+    ap.add_argument("--build", type=Path, help="a build tree: check its targets' objects too")
     args = ap.parse_args(argv)
     violations, stats = check_tree(args.src)
+    if args.build is not None:
+        graphs = object_graphs(args.build)
+        violations += check_objects(graphs)
+        print(f"{len(graphs)} targets' objects read", file=sys.stderr)
     for v in violations:
         print(v)
     print(

@@ -1,10 +1,12 @@
 """Dependencies flow one way (issue 17): the repository's C include graph and Python import graph
-have no cycles and no upward edges except firmware/app -> hal/hal.h (tests/lint/layers.py), and
-the checker itself fails on graphs that break those rules."""
+have no cycles and no upward edges except firmware/app -> hal/hal.h, no target's objects depend on
+each other both ways (tests/lint/layers.py), and the checker itself fails on graphs that break
+those rules."""
 
 from __future__ import annotations
 
 import os
+import subprocess
 import sys
 import textwrap
 from pathlib import Path
@@ -162,3 +164,36 @@ def test_tarjan_finds_every_strongly_connected_component() -> None:
     g = {"a": {"b"}, "b": {"c"}, "c": {"a", "d"}, "d": {"e"}, "e": {"d"}, "f": {"f", "a"}}
     assert layers.cycles(g) == [["a", "b", "c"], ["d", "e"]]
     assert layers.cycles({"a": {"b"}, "b": set()}) == []
+
+
+def test_no_target_needs_the_file_with_main_for_a_helper() -> None:
+    build = Path(os.environ.get("ODO_BUILD_DIR") or ROOT / "build" / "host")
+    graphs = layers.object_graphs(build)
+    # odo-ipec and odo-calib are among the targets read: their commands' objects depend one way
+    assert graphs["tools/ipec/CMakeFiles/odo-ipec.dir"]["odo-ipec.c.o"] >= {
+        "ipec_goals.c.o",
+        "ipec_sim.c.o",
+    }
+    assert "odo-ipec.c.o" not in set().union(*graphs["tools/ipec/CMakeFiles/odo-ipec.dir"].values())
+    assert len(graphs) > 10
+    assert layers.check_objects(graphs) == []
+
+
+def test_object_check_finds_a_helper_in_the_main_file(tmp_path: Path) -> None:
+    sources = {
+        "t/CMakeFiles/tool.dir/main.c": "int cmd(void);\nint helper(void) { return 1; }\n"
+        "int main(void) { return cmd(); }\n",
+        "t/CMakeFiles/tool.dir/cmd.c": "int helper(void);\nint cmd(void) { return helper(); }\n",
+        "t/CMakeFiles/ok.dir/main.c": "int cmd(void);\nint main(void) { return cmd(); }\n",
+        "t/CMakeFiles/ok.dir/cmd.c": "int cmd(void) { return 0; }\n",
+    }
+    for rel, text in sources.items():
+        c = tmp_path / rel
+        c.parent.mkdir(parents=True, exist_ok=True)
+        c.write_text(text)
+        subprocess.run(["cc", "-c", str(c), "-o", f"{c}.o"], check=True)
+    graphs = layers.object_graphs(tmp_path)
+    assert graphs["t/CMakeFiles/ok.dir"] == {"main.c.o": {"cmd.c.o"}, "cmd.c.o": set()}
+    assert layers.check_objects(graphs) == [
+        "object cycle in t/CMakeFiles/tool.dir: cmd.c.o <-> main.c.o"
+    ]

@@ -10,6 +10,7 @@
 #include "fit_model.h"
 #include "odo_params_json.h"
 #include "odo_robot.h"
+#include "params_out.h"
 
 #define MAX_ARGS 64
 

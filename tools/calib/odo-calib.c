@@ -19,6 +19,7 @@
 #include "acceptance.h"
 #include "calib_core.h"
 #include "fit_cli.h"
+#include "params_out.h"
 #include "image.h"
 #include "odo_cli.h"
 #include "odo_out.h"
@@ -110,44 +111,6 @@ static const char *opt(const opt_t *o, size_t n, const char *name)
         }
     }
     return NULL;
-}
-
-static int ends_with(const char *s, const char *suf)
-{
-    const size_t a = strlen(s), b = strlen(suf);
-    return a >= b && strcmp(s + a - b, suf) == 0;
-}
-
-/// Write an output by hostlib/odo_out.h's rule (temp beside it, fsync, rename; never an input).
-static int write_atomic(const char *path, const void *data, size_t len, const odo_out_inputs_t *ins)
-{
-    char err[PATH_MAX + 256];
-    if (odo_out_write(path, data, len, ins, err, sizeof err) != 0) {
-        fprintf(stderr, "%s: %s\n", k_prog, err);
-        return -1;
-    }
-    return 0;
-}
-
-/// Parameters as JSON text (malloc'd) or as the 128-byte block, by the output's extension.
-int calib_write_params(const char *path, const odo_params_t *p, const odo_out_inputs_t *ins)
-{
-    if (ends_with(path, ".bin")) {
-        uint8_t block[ODO_PARAMS_SIZE];
-        (void)odo_params_encode(p, block, sizeof block);
-        return write_atomic(path, block, sizeof block, ins);
-    }
-    char *buf = NULL;
-    size_t len = 0;
-    FILE *m = open_memstream(&buf, &len);
-    if (m == NULL || odo_params_json_write(m, p) != 0 || fclose(m) != 0) {
-        free(buf);
-        fprintf(stderr, "%s: out of memory\n", k_prog);
-        return -1;
-    }
-    const int rc = write_atomic(path, buf, len, ins);
-    free(buf);
-    return rc;
 }
 
 /* ---------------------------------------------------------------------------------------------
