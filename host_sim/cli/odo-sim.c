@@ -154,11 +154,7 @@ int main(int argc, char **argv)
     const char *params_path = NULL; /* --params: calibration for the firmware */
     bool force = false;
     uint64_t log_start_us = 0U; /* --log-start; else SOURCE_DATE_EPOCH, else the wall clock */
-    if (odo_log_start_default(&log_start_us) != 0) {
-        fprintf(stderr, "odo-sim: SOURCE_DATE_EPOCH must be whole seconds 0..%llu\n",
-                (unsigned long long)ODO_LOG_START_MAX_S);
-        return 2;
-    }
+    bool log_start_given = false;
     enum {
         O_EXPERIMENT = 256,
         O_VEHICLE,
@@ -234,6 +230,7 @@ int main(int argc, char **argv)
                         (unsigned long long)ODO_LOG_START_MAX_S, optarg);
                 return 2;
             }
+            log_start_given = true;
             break;
         case O_FORCE: force = true; break;
         case O_QUIET: quiet = 1; break;
@@ -241,6 +238,13 @@ int main(int argc, char **argv)
         case O_LIST: list_effects = 1; break;
         default: odo_cli_usage_hint("odo-sim"); return 2;
         }
+    }
+    /* the default is read only when it is needed, so --help and --log-start work whatever
+       SOURCE_DATE_EPOCH holds */
+    if (!log_start_given && odo_log_start_default(&log_start_us) != 0) {
+        fprintf(stderr, "odo-sim: SOURCE_DATE_EPOCH must be whole seconds 0..%llu\n",
+                (unsigned long long)ODO_LOG_START_MAX_S);
+        return 2;
     }
     if (optind < argc) {
         fprintf(stderr, "odo-sim: unexpected argument '%s'\n", argv[optind]);
