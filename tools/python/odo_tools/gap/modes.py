@@ -12,6 +12,8 @@
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass, field
+from typing import Protocol
 
 import numpy as np
 
@@ -21,6 +23,38 @@ from .model import Prepared, dead_reckon, link_bias, rough_moments, rough_window
 WINDOW_S = 0.4  # truth increments: window length
 HORIZON_S = 1.0  # linkage mode: prediction horizon
 ANCHOR_S = 2.0  # truth mode: the start pose is fitted over this much of the run
+
+
+class EvidenceMode(Protocol):
+    """What every evidence mode offers the fits, the held-out evaluation and the plots. One
+    object per run; `P` is a hypothesis (catalog parameters 'effect.param', absent = nominal)."""
+
+    name: str
+    pr: Prepared
+
+    def channels(self) -> list[str]:
+        """Names of the residual columns, with units in the suffix."""
+        ...
+
+    def residuals(self, P: dict) -> np.ndarray:
+        """(rows, channels) recorded minus model."""
+        ...
+
+    def extra_var(self, P: dict) -> np.ndarray | None:
+        """Variance a hypothesis adds to each residual (roughness), or None."""
+        ...
+
+    def noise_weights(self) -> np.ndarray:
+        """Expected z^2 per value of each channel under noise alone."""
+        ...
+
+    def sys_z(self, P: dict, sigma: np.ndarray) -> np.ndarray:
+        """Standardised residuals of the held-out gap (diagnose: systematic gap)."""
+        ...
+
+    def gap(self, P: dict) -> float:
+        """The gap a person reads, in mm."""
+        ...
 
 
 def _body_inc(p: np.ndarray, i: np.ndarray, j: np.ndarray) -> np.ndarray:
@@ -43,24 +77,55 @@ def _censored(x: np.ndarray, code: np.ndarray, step: float, angle: bool) -> np.n
     return np.clip(d, -tol, step + tol) - d
 
 
+def to_centre(pose: np.ndarray, lever_mm: list[tuple[float, float]]) -> np.ndarray:
+    """Tracked-point poses (n, trucks, 3) -> axle-centre poses: subtract the lever arm (x forward,
+    y left, mm) rotated by the measured heading."""
+    out = pose.copy()
+    for t in range(pose.shape[1]):
+        ox, oy = lever_mm[t] if t < len(lever_mm) else (0.0, 0.0)
+        if ox == 0.0 and oy == 0.0:
+            continue
+        c, s_ = np.cos(pose[:, t, 2]), np.sin(pose[:, t, 2])
+        out[:, t, 0] -= c * ox - s_ * oy
+        out[:, t, 1] -= s_ * ox + c * oy
+    return out
+
+
 def _grain_count_cv2(P: dict) -> float:
     """Squared coefficient of variation of the grain count: gaps spacing * (1 + jitter U(-1, 1))
     make a renewal count of variance n cv^2, cv^2 = jitter^2 / 3."""
     return P.get("roughness.jitter", 0.5) ** 2 / 3.0
 
 
+@dataclass
+class Instrument:
+    """How the truth was measured, beyond its noise: where the tracked point sits on each truck
+    (x forward, y left of the axle centre, mm) and how late each run's truth is against the
+    robot's clock (s; the truth sample stamped t shows the pose at t - latency). Nuisances of the
+    truth, estimated from the data (instrument.estimate), never part of a hypothesis."""
+
+    lever_mm: list[tuple[float, float]] = field(default_factory=lambda: [(0.0, 0.0)] * 2)
+    lever_se_mm: list[tuple[float, float]] = field(default_factory=lambda: [(0.0, 0.0)] * 2)
+    latency_s: dict[str, float] = field(default_factory=dict)
+
+
 class TruthMode:
     name = "truth"
     gof = True  # its noise is measured per sample (TruthMode.noise_diffs): a fit test holds
 
-    def __init__(self, pr: Prepared, robot: Robot) -> None:
+    def __init__(self, pr: Prepared, robot: Robot, instrument: Instrument | None = None) -> None:
         tr = pr.run.truth
         assert tr is not None
         self.pr, self.robot = pr, robot
-        t0, t1 = max(tr.t_s[0], pr.t[0]), min(tr.t_s[-1], pr.t[-1])
-        sel = (tr.t_s >= t0 - 1e-9) & (tr.t_s <= t1 + 1e-9)
-        self.tt = tr.t_s[sel]
-        self.tpose = tr.pose[sel]
+        inst = instrument or Instrument()
+        lat = inst.latency_s.get(pr.run.name, 0.0)
+        t_true = tr.t_s - lat
+        t0, t1 = max(t_true[0], pr.t[0]), min(t_true[-1], pr.t[-1])
+        sel = (t_true >= t0 - 1e-9) & (t_true <= t1 + 1e-9)
+        if sel.sum() < 10:
+            raise ValueError(f"{pr.run.name}: fewer than 10 truth samples overlap the log")
+        self.tt = t_true[sel]
+        self.tpose = to_centre(tr.pose[sel], inst.lever_mm)
         self.tlink = tr.link[sel] if tr.link is not None else None
         dt = float(np.median(np.diff(self.tt)))
         W = max(1, round(WINDOW_S / dt))
@@ -217,9 +282,17 @@ class TruthMode:
         m = self.anchored({}, truck)
         r = self.tpose[:, truck, :] - m
         r[:, 2] = np.unwrap(r[:, 2])
-        dt = np.diff(self.tt)
-        even = np.abs(dt[1:] - dt[:-1]) <= 1e-6 * np.maximum(dt[1:], 1e-9)
-        d2 = (r[2:] - 2.0 * r[1:-1] + r[:-2])[even]
+        # unevenly spaced samples (a truth with timing jitter, or at its own rate): the second
+        # divided difference, scaled so that white noise of variance sigma^2 gives 6 sigma^2 as
+        # the plain second difference of even samples does
+        h1, h2 = np.diff(self.tt)[:-1], np.diff(self.tt)[1:]
+        ok = (h1 > 0) & (h2 > 0)
+        h1, h2 = np.where(ok, h1, 1.0), np.where(ok, h2, 1.0)
+        w0, w2 = 1.0 / h1, 1.0 / h2
+        w1 = w0 + w2
+        d = w2[:, None] * r[2:] - w1[:, None] * r[1:-1] + w0[:, None] * r[:-2]
+        scale = np.sqrt(6.0 / (w0 * w0 + w1 * w1 + w2 * w2))
+        d2 = (d * scale[:, None])[ok]
         return d2[:, :2].ravel(), d2[:, 2]
 
     def stationary(self) -> np.ndarray:
@@ -282,6 +355,9 @@ class ReturnsMode:
 
     def noise_weights(self) -> np.ndarray:
         return np.ones(len(self.channels()))
+
+    def sys_z(self, P: dict, sigma: np.ndarray) -> np.ndarray:
+        return self.residuals(P) / sigma
 
     def gap(self, P: dict) -> float:
         r = self.residuals(P)[0]
@@ -418,6 +494,9 @@ class LinkageMode:
 
     def noise_weights(self) -> np.ndarray:
         return np.ones(len(self.channels()))
+
+    def sys_z(self, P: dict, sigma: np.ndarray) -> np.ndarray:
+        return self.residuals(P) / sigma
 
     def gap(self, P: dict) -> float:
         r = self._pred(P)

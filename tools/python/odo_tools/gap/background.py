@@ -1,0 +1,200 @@
+"""The background every real world carries, measured from the data: the share of the gap that no
+hypothesis should be asked to remove (issue 13 item 2, DESIGN.md s. 6).
+
+A floor is never perfect: every wheel's floor travel wanders a little from its rotation (grains,
+joints, tyre give), which shortens travel a little and random-walks the heading. On top of that
+the truth has its own noise. Both are measured here, and the verdict is decided against them in
+absolute terms (held-out mm and deg left after the fit, beside what the background alone would
+leave), instead of against the nominal misfit.
+
+- **Truth mode.** The random walk's intensity `q_wheel` (mm^2 of floor-travel variance per mm of
+  a wheel's travel), from the heading residual under the candidate effect (its systematic part
+  removed): differences of adjacent blocks of 0.4, 0.8 and 1.6 s cancel whatever changes slowly
+  along the run, and their robust variance grows as a + (q_wheel / b^2) x travel; the intercept
+  takes the truth's own noise, correlated over a window or not (`walk`). The accumulated error
+  the walk leaves along a held-out run (`track_var`) plus the truth's sample noise is that run's
+  background allowance.
+- **Returns mode.** The spread of each path's return poses about their mean (fit.estimate_sigma),
+  or the stated accuracy of the return measurement; the held-out allowance is that spread.
+
+A floor's roughness is also a catalog effect: the verdict names it when its hypothesis (grains
+that shorten travel on average and spread it) closes the held-out gap like any other; the walk
+measured here is what is left after the candidate, whatever it is.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .modes import TruthMode
+
+
+@dataclass
+class Background:
+    mode: str
+    q_wheel: list[float] = field(default_factory=list)  # per truck, mm^2 per mm of wheel travel
+    q_wheel_ci: list[tuple[float, float]] = field(default_factory=list)  # 68 % bootstrap
+    # truth: each truck channel's noise per window at the window scale (sqrt(intercept / 3) of
+    # the multi-scale fit: 3 window variances for white sample noise), which also holds noise
+    # correlated over a window that the samples' second differences miss
+    window_sigma: np.ndarray | None = None
+    spread: np.ndarray | None = None  # returns: per channel sigma of the runs about their path mean
+
+    def window_var(self, item: TruthMode) -> np.ndarray | None:
+        """Variance the walk adds to each truth window's residual (nwin, channels)."""
+        if self.mode != "truth" or not any(q > 0 for q in self.q_wheel):
+            return None
+        out = np.zeros((item.i.size, len(item.channels())))
+        for t, q in enumerate(self.q_wheel[: item.trucks]):
+            if q <= 0:
+                continue
+            E = item.wtravel[t, 0] + item.wtravel[t, 1]
+            b = item.pr.b[t]
+            Lt = 0.5 * E
+            out[:, 3 * t] = q * E / 4.0
+            out[:, 3 * t + 1] = q * E / b**2 * Lt**2 / 3.0
+            out[:, 3 * t + 2] = q * E / b**2
+        return out
+
+    def track_var(self, item: TruthMode, truck: int) -> np.ndarray:
+        """(nwin, 3) variance of the accumulated x, y (mm^2) and heading (rad^2) error the walk
+        leaves at each window start of a run: every tick's floor-travel noise of either wheel,
+        propagated to that point (a wheel's shortfall d turns the truck by -/+ d/b, which carries
+        the rest of the path sideways, and moves it back by d/2)."""
+        q = self.q_wheel[truck] if truck < len(self.q_wheel) else 0.0
+        pr = item.pr
+        tw = item.tt[item.i]
+        n_out = tw.size
+        if q <= 0:
+            return np.zeros((n_out, 3))
+        from .model import dead_reckon
+
+        p = dead_reckon(pr, {}, truck)
+        pm = 0.5 * (p[:-1] + p[1:])
+        c, s_ = np.cos(pm[:, 2]), np.sin(pm[:, 2])
+        ew = np.abs(pr.ds[:, truck, :]) * q  # (n-1, 2) variance per tick per wheel
+        b = pr.b[truck]
+        # tick k's noise reaches a later point P as g = (-u_k / 2 -/+ J (P - p_k) / b): with the
+        # sums A = sum e, Bx = sum e x_k, Cx = sum e x_k^2 ... up to P, Var = quadratic in P.
+        k_end = np.clip(np.searchsorted(pr.t, tw, side="right") - 1, 0, pm.shape[0])
+        out = np.zeros((n_out, 3))
+        for w, sw in ((0, 1.0), (1, -1.0)):
+            e = ew[:, w]
+            x, y = pm[:, 0], pm[:, 1]
+            # the along-track part (-u/2) and the lateral part (-/+ J (P - p)/b) are combined per
+            # coordinate: gx = -c/2 - sw (Py - y)/b, gy = -s/2 + sw (Px - x)/b
+            cs = lambda a: np.concatenate([[0.0], np.cumsum(a)])  # noqa: E731
+            S0, Sy, Syy = cs(e), cs(e * y), cs(e * y * y)
+            Sx, Sxx = cs(e * x), cs(e * x * x)
+            Sc, Scc, Scy = cs(e * c), cs(e * c * c), cs(e * c * y)
+            Ss, Sss, Ssx = cs(e * s_), cs(e * s_ * s_), cs(e * s_ * x)
+            kk = k_end
+            Px = np.interp(tw, pr.t, p[:, 0])
+            Py = np.interp(tw, pr.t, p[:, 1])
+            a = sw / b
+            # E[gx^2 e] = sum e (c/2 + a (Py - y))^2
+            vx = (
+                0.25 * Scc[kk]
+                + a * (Py * Sc[kk] - Scy[kk])
+                + a * a * (Py * Py * S0[kk] - 2 * Py * Sy[kk] + Syy[kk])
+            )
+            vy = (
+                0.25 * Sss[kk]
+                - a * (Px * Ss[kk] - Ssx[kk])
+                + a * a * (Px * Px * S0[kk] - 2 * Px * Sx[kk] + Sxx[kk])
+            )
+            out[:, 0] += vx
+            out[:, 1] += vy
+            out[:, 2] += S0[kk] / b**2
+        return np.maximum(out, 0.0)
+
+
+BLOCKS = (1, 2, 4)  # block lengths in windows (0.4, 0.8, 1.6 s) of the multi-scale estimate
+
+
+def _block_diffs(r: np.ndarray, E: np.ndarray, k: int) -> tuple[np.ndarray, np.ndarray]:
+    """Differences of adjacent k-window sums of a residual, and the travel they span."""
+    n = r.size // k
+    if n < 2:
+        return np.zeros(0), np.zeros(0)
+    R = r[: n * k].reshape(n, k).sum(axis=1)
+    EE = E[: n * k].reshape(n, k).sum(axis=1)
+    return np.diff(R), EE[1:] + EE[:-1]
+
+
+def _multiscale(per_run: list[tuple[np.ndarray, np.ndarray]]) -> tuple[float, float]:
+    """(intercept, slope) of the robust variance of adjacent block differences of a residual
+    against the travel E they span, over blocks of 1, 2 and 4 windows."""
+    xs, ys, ws = [], [], []
+    for k in BLOCKS:
+        d = [_block_diffs(r, E, k) for r, E in per_run]
+        dd = np.concatenate([x[0] for x in d])
+        ee = np.concatenate([x[1] for x in d])
+        if dd.size < 8:
+            continue
+        s = 1.4826 * np.median(np.abs(dd - np.median(dd)))
+        xs.append(float(ee.mean()))
+        ys.append(float(s * s))
+        ws.append(dd.size)
+    if len(xs) < 2:
+        return (ys[0] if ys else 0.0), 0.0
+    x, y, w = (np.asarray(v, dtype=float) for v in (xs, ys, ws))
+    A = np.column_stack([np.ones_like(x), x]) * np.sqrt(w)[:, None]
+    coef = np.linalg.lstsq(A, y * np.sqrt(w), rcond=None)[0]
+    if coef[1] < 0:  # no walk: the intercept is the mean level
+        return float(np.average(y, weights=w)), 0.0
+    return max(float(coef[0]), 0.0), float(coef[1])
+
+
+def walk(per_run: list[tuple[np.ndarray, np.ndarray]], b: float) -> float:
+    """q_wheel from the heading residuals and window travel of runs (module doc): adjacent block
+    differences at 0.4, 0.8 and 1.6 s; their robust variance grows as a + (q_wheel / b^2) E with
+    the travel E they span. The intercept takes the truth's noise, correlated over a window or
+    not (a motion-capture heading often is); the slope is the walk."""
+    return _multiscale(per_run)[1] * b * b
+
+
+def measure(
+    items: list, sigma: np.ndarray, mode: str, P: dict | None = None, seed: int = 1
+) -> Background:
+    """The background of the fitting runs, under the candidate P (its systematic part must not
+    be taken for a walk)."""
+    bg = Background(mode)
+    if mode == "truth":
+        P = P or {}
+        T = items[0].trucks
+        ws = np.zeros(len(items[0].channels()))
+        res = [it.residuals(P) for it in items]
+        for t in range(T):
+            for c in range(3 * t, 3 * t + 3):
+                per = [
+                    (r[:, c], it.wtravel[t, 0] + it.wtravel[t, 1])
+                    for r, it in zip(res, items, strict=False)
+                ]
+                ws[c] = math.sqrt(_multiscale(per)[0] / 3.0)
+        bg.window_sigma = ws
+        for t in range(T):
+            per_run = [
+                (r[:, 3 * t + 2], it.wtravel[t, 0] + it.wtravel[t, 1])
+                for r, it in zip(res, items, strict=False)
+            ]
+            b = items[0].pr.b[t]
+            q = walk(per_run, b)
+            rng = np.random.default_rng(seed)
+            boots = []
+            for _ in range(30):
+                k = rng.integers(0, len(per_run), len(per_run))
+                boots.append(walk([per_run[i] for i in k], b))
+            bg.q_wheel.append(q)
+            bg.q_wheel_ci.append((float(np.percentile(boots, 16)), float(np.percentile(boots, 84))))
+    elif mode == "returns":
+        bg.spread = np.asarray(sigma, dtype=float)
+    return bg
+
+
+def heading_walk_deg_per_sqrt_m(q_wheel: float, b_mm: float) -> float:
+    """The walk in words: heading spread (deg) after 1 m of straight travel (2 m of wheels)."""
+    return math.degrees(math.sqrt(max(q_wheel, 0.0) * 2000.0) / b_mm)

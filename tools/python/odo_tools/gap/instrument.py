@@ -1,0 +1,161 @@
+"""Nuisances of a truth track, estimated from the data before any hypothesis is fitted.
+
+A motion-capture track is not the axle centre at the robot's clock: the marker sits somewhere on
+the body (a lever arm of up to a few cm), and the two clocks are offset (latency, often different
+per run). Both move the truth in ways no catalog effect should be asked to explain:
+
+- **Lever arm** (per truck, x forward and y left of the axle centre): on a turn on the spot the
+  centre stays put while the marker circles it, so the marker's increments there are
+  (R(dtheta) - I) o, linear in o, with the measured heading change. Fitted on those windows only
+  (on arcs an Eb or a scrub misfit is correlated with it); without spot turns it is left at zero
+  and the report says so.
+- **Latency** (per run): the truth's heading increments against the nominal model's, over a grid
+  of time shifts; kept only where it lowers the misfit beyond chance (Delta chi^2 >= 25), so a
+  truth sampled at the robot's ticks is not shifted by a few ms of noise.
+
+The OptiOdom circles carry ~0.1-0.3 s of latency between mocap and wheel counts (their heading
+misfit follows the turn rate), the squares ~25 ms; the lever arm of its marker is ~1-2 cm.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .model import Prepared, dead_reckon
+from .modes import WINDOW_S, Instrument, _body_inc
+
+LATENCY_MAX_S = 0.5
+LATENCY_STEP_S = 0.005
+LATENCY_DCHI2 = 25.0  # a shift must lower the heading misfit by this much (in noise units)
+LEVER_MIN_WINDOWS = 10
+LEVER_SIGNIFICANT = 3.0  # |o| in standard errors below which the lever arm is left at zero
+SPOT_TURN_RAD = 0.05  # a window turning at least this much ...
+SPOT_TRAVEL = 0.1  # ... while its centre moves less than this x (b/2) x |dtheta|
+
+
+def estimate(prs: list[Prepared], trucks: int) -> tuple[Instrument, list[str]]:
+    """(instrument, notes for the report) from the runs that have a truth track."""
+    inst = Instrument(lever_mm=[(0.0, 0.0)] * trucks, lever_se_mm=[(0.0, 0.0)] * trucks)
+    notes = []
+    with_truth = [pr for pr in prs if pr.run.truth is not None]
+    for pr in with_truth:
+        inst.latency_s[pr.run.name] = latency(pr)
+    for t in range(trucks):
+        o, se, n = lever_arm(with_truth, t, inst)
+        if o is None:
+            notes.append(
+                f"truck {'AB'[t]}: lever arm of the tracked point not estimated ({n} "
+                "windows turning on the spot; needs 10): taken as zero"
+            )
+            continue
+        inst.lever_se_mm[t] = se
+        z = math.hypot(o[0] / max(se[0], 1e-9), o[1] / max(se[1], 1e-9))
+        if z >= LEVER_SIGNIFICANT and math.hypot(*o) >= 1.0:
+            inst.lever_mm[t] = o
+    return inst, notes
+
+
+def _windows(tt: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    dt = float(np.median(np.diff(tt)))
+    W = max(1, round(WINDOW_S / dt))
+    i = np.arange(0, tt.size - W, W)
+    return i, i + W
+
+
+def _mad(x: np.ndarray) -> float:
+    return float(1.4826 * np.median(np.abs(x - np.median(x)))) if x.size else 0.0
+
+
+def latency(pr: Prepared, truck: int = 0) -> float:
+    """The shift (s) that best lines the truth's heading increments up with the nominal model's,
+    or 0 when no shift helps beyond chance."""
+    tr = pr.run.truth
+    th_m = dead_reckon(pr, {}, truck)[:, 2]
+    tt, th_t = tr.t_s, tr.pose[:, truck, 2]
+    i, j = _windows(tt)
+    if i.size < 10:
+        return 0.0
+    dth = th_t[j] - th_t[i]
+
+    def resid(L: float) -> np.ndarray:
+        tm = tt - L
+        ok = (tm[i] >= pr.t[0]) & (tm[j] <= pr.t[-1])
+        m = np.interp(tm, pr.t, th_m)
+        r = dth - (m[j] - m[i])
+        return np.where(ok, r, np.nan)
+
+    grid = np.arange(-LATENCY_MAX_S, LATENCY_MAX_S + 1e-9, LATENCY_STEP_S)
+    R = np.array([resid(L) for L in grid])
+    usable = np.all(np.isfinite(R), axis=0)
+    if usable.sum() < 10:
+        return 0.0
+    R = R[:, usable]
+    cost = np.sum(R * R, axis=1)
+    k0 = int(np.argmin(np.abs(grid)))
+    k = int(np.argmin(cost))
+    # noise of a window's heading increment: adjacent windows' differences at the best shift
+    s = _mad(np.diff(R[k])) / math.sqrt(2.0)
+    if not s > 0 or (cost[k0] - cost[k]) / (s * s) < LATENCY_DCHI2:
+        return 0.0
+    L = float(grid[k])
+    if 0 < k < grid.size - 1:  # parabola through the three best
+        c0, c1, c2 = cost[k - 1], cost[k], cost[k + 1]
+        den = c0 - 2 * c1 + c2
+        if den > 0:
+            L += float(0.5 * (c0 - c2) / den * LATENCY_STEP_S)
+    return L
+
+
+def lever_arm(
+    prs: list[Prepared], truck: int, inst: Instrument
+) -> tuple[tuple[float, float] | None, tuple[float, float], int]:
+    """Least squares of the marker's increments on spot turns: ((ox, oy), (se_x, se_y), windows)."""
+    A_rows, r_rows = [], []
+    for pr in prs:
+        tr = pr.run.truth
+        if truck >= tr.pose.shape[1]:
+            continue
+        tt = tr.t_s - inst.latency_s.get(pr.run.name, 0.0)
+        i, j = _windows(tt)
+        ok = (tt[i] >= pr.t[0]) & (tt[j] <= pr.t[-1])
+        i, j = i[ok], j[ok]
+        if i.size == 0:
+            continue
+        p = dead_reckon(pr, {}, truck)
+        m = np.column_stack([np.interp(tt, pr.t, p[:, k]) for k in range(3)])
+        inc_t = _body_inc(tr.pose[:, truck], i, j)
+        inc_m = _body_inc(m, i, j)
+        dth = inc_t[:, 2]
+        travel = np.hypot(inc_m[:, 0], inc_m[:, 1])
+        spot = (np.abs(dth) >= SPOT_TURN_RAD) & (
+            travel < SPOT_TRAVEL * 0.5 * pr.b[truck] * np.abs(dth)
+        )
+        if not spot.any():
+            continue
+        c, s_ = np.cos(dth[spot]), np.sin(dth[spot])
+        # (R(dtheta) - I) o, rows for x and y
+        A = np.stack(
+            [np.column_stack([c - 1.0, -s_]), np.column_stack([s_, c - 1.0])], axis=1
+        ).reshape(-1, 2)
+        r = (inc_t[spot, :2] - inc_m[spot, :2]).reshape(-1)
+        A_rows.append(A)
+        r_rows.append(r)
+    n = sum(a.shape[0] // 2 for a in A_rows)
+    if n < LEVER_MIN_WINDOWS:
+        return None, (0.0, 0.0), n
+    A, r = np.vstack(A_rows), np.concatenate(r_rows)
+    w = np.ones(r.size)
+    o = np.zeros(2)
+    for _ in range(5):  # Huber-weighted: a bump on a turn must not pull the marker around
+        Aw = A * w[:, None]
+        o = np.linalg.lstsq(Aw, r * w, rcond=None)[0]
+        e = r - A @ o
+        s = max(_mad(e), 1e-6)
+        w = np.sqrt(np.minimum(1.0, 1.5 * s / np.maximum(np.abs(e), 1e-12)))
+    e = r - A @ o
+    s2 = float(np.sum((w * e) ** 2) / max(r.size - 2, 1))
+    cov = np.linalg.pinv((A * w[:, None]).T @ (A * w[:, None])) * s2
+    se = (float(math.sqrt(max(cov[0, 0], 0.0))), float(math.sqrt(max(cov[1, 1], 0.0))))
+    return (float(o[0]), float(o[1])), se, n

@@ -1,0 +1,1 @@
+"""Validation of the gap diagnosis on worlds it did not generate (the blind check)."""
