@@ -56,7 +56,7 @@ def test_a_diagnosing_process_cannot_open_a_key(tmp_path: Path) -> None:
     keys.mkdir()
     (keys / "case-000.json").write_text('{"effects": ["ed"]}')
     (tmp_path / "data.txt").write_text("recorded")
-    code = (f"from odo_tools.gap.blind import guard; guard({str(keys)!r}); "
+    code = (f"from odo_tools.validation.blind import guard; guard({str(keys)!r}); "
             f"print(open({str(tmp_path / 'data.txt')!r}).read()); "
             f"open({str(keys / 'case-000.json')!r})")
     r = subprocess.run([PY, "-c", code], env=env(), capture_output=True, text=True, timeout=60)

@@ -80,8 +80,8 @@ def test_slip_loss_matches_the_simulators_law_seen_through_40ms_counts(
 
 @pytest.mark.parametrize("vehicle", ["clapper", "set"])
 def test_a_no_effect_two_truck_vehicle_is_no_significant_gap(vehicle: str, tmp_path: Path) -> None:
-    from odo_tools.gap import blind
     from odo_tools.gap.diagnose import diagnose
+    from odo_tools.validation import blind
 
     case = {"case": 0, "vehicle": vehicle, "kind": "none", "effects": [], "params": {},
             "hidden": {}, "n_bumps": 0,

@@ -50,6 +50,7 @@ class Problem:
         if sigma is not None:
             self.sigma = sigma
         self.__dict__.pop("e0", None)
+        self.__dict__.pop("_vcache", None)
 
     def resid(self, P: dict) -> np.ndarray:
         return np.vstack([it.residuals(P) for it in self.items])
@@ -64,18 +65,22 @@ class Problem:
         is correlated and whose truth carries slow offsets after each start, it fitted Ed 1.066
         (returns say 0.999): local increments are the robust choice for real truth."""
         rough = P.get("roughness.max_height_mm", 0.0) > 0
+        cache = self.__dict__.setdefault("_vcache", {})
+        if rough not in cache:
+            parts = []
+            for it in self.items:
+                n = it.residuals({}).shape[0]
+                v = np.broadcast_to(self.sigma**2, (n, self.sigma.size)).copy()
+                if not rough and self.walk is not None:
+                    w = self.walk.window_var(it)
+                    if w is not None:
+                        v += w
+                parts.append(v)
+            cache[rough] = parts
         out = []
-        for it in self.items:
-            n = it.residuals({}).shape[0]
-            v = np.broadcast_to(self.sigma**2, (n, self.sigma.size)).copy()
-            if not rough and self.walk is not None:
-                w = self.walk.window_var(it)
-                if w is not None:
-                    v += w
+        for it, v in zip(self.items, cache[rough], strict=False):
             e = it.extra_var(P)
-            if e is not None:
-                v += e
-            out.append(v)
+            out.append(v if e is None else v + e)
         return out
 
     def _whitened(self, P: dict) -> tuple[list[np.ndarray], float]:

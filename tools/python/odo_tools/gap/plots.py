@@ -41,7 +41,8 @@ def plot_report(rep: dict, ctx: Context, out: Path) -> None:
 def plot_ranking(rep: dict, path: Path) -> None:
     """Delta BIC against the nominal model, signed: a hypothesis worse than nominal shows as
     such (a symmetric-log axis, not a clamp)."""
-    rk = [r for r in rep["ranking"] if r["effect"] != "nominal"][:14]
+    allr = [r for r in rep["ranking"] if r["effect"] != "nominal"]
+    rk = allr[:12] + [r for r in allr[12:] if r["dbic_vs_nominal"] < 0][-4:]
     names = [r["effect"] for r in rk][::-1]
     vals = np.array([r["dbic_vs_nominal"] for r in rk][::-1])
     best = rep["verdict"]["best_hypothesis"]
@@ -85,7 +86,9 @@ def plot_gap_along_path(rep: dict, ctx: Context, path: Path) -> None:
                 ax.plot(d, np.hypot(e1[:, 0], e1[:, 1]), "C2-", lw=1.2, label=f"+ {name}")
             bmm = _background_track(rep, it, k, ctx)
             if bmm is not None:
-                ax.fill_between(bmm[0], 0, bmm[1], color="C1", alpha=0.15, label="background")
+                ax.fill_between(
+                    bmm[0], 0, bmm[1], color="C1", alpha=0.15, label="background (2 sigma)"
+                )
             lab = classify(pr)
             lt = lab[np.clip(np.searchsorted(pr.t[1:], tt), 0, lab.size - 1)]
             for s, c in PHASE_COLORS.items():

@@ -121,6 +121,10 @@ class Report:
     def shrink(self) -> float:
         return self.heldout["shrink"]
 
+    def __getitem__(self, key: str):
+        """report["verdict"] as in report.json (scripts and tests read it like the file)."""
+        return self.to_dict()[key]
+
     def to_dict(self) -> dict:
         d = asdict(self) if self.context is None else asdict(_without_context(self))
         d.pop("context", None)
