@@ -8,8 +8,10 @@ absolute terms (held-out mm and deg left after the fit, beside what the backgrou
 leave), instead of against the nominal misfit.
 
 - **Truth mode.** The random walk's intensity `q_wheel` (mm^2 of floor-travel variance per mm of
-  a wheel's travel), from the heading residual under the candidate effect (its systematic part
-  removed): differences of adjacent blocks of 0.4, 0.8 and 1.6 s cancel whatever changes slowly
+  a wheel's travel), from the heading residual under the candidate effect, less what the other
+  runs of the same path show at the same travel (`unrepeated`: a walk differs from run to run,
+  a misfit the candidate leaves repeats): differences of adjacent blocks of 0.4 to 3.2 s cancel
+  whatever changes slowly
   along the run, and their robust variance grows as a + (q_wheel / b^2) x travel; the intercept
   takes the truth's own noise, correlated over a window or not (`walk`). The accumulated error
   the walk leaves along a held-out run (`track_var`) plus the truth's sample noise is that run's
@@ -112,7 +114,7 @@ class Background:
         return np.maximum(out, 0.0)
 
 
-BLOCKS = (1, 2, 4)  # block lengths in windows (0.4, 0.8, 1.6 s) of the multi-scale estimate
+BLOCKS = (1, 2, 4, 8)  # block lengths in windows (0.4 - 3.2 s) of the multi-scale estimate
 
 
 def _block_diffs(r: np.ndarray, E: np.ndarray, k: int) -> tuple[np.ndarray, np.ndarray]:
@@ -142,6 +144,7 @@ def _multiscale(per_run: list[tuple[np.ndarray, np.ndarray]]) -> tuple[float, fl
     if len(xs) < 2:
         return (ys[0] if ys else 0.0), 0.0
     x, y, w = (np.asarray(v, dtype=float) for v in (xs, ys, ws))
+    w = w / np.maximum(y, 1e-300) ** 2  # a variance estimate's own variance grows as its square
     A = np.column_stack([np.ones_like(x), x]) * np.sqrt(w)[:, None]
     coef = np.linalg.lstsq(A, y * np.sqrt(w), rcond=None)[0]
     if coef[1] < 0:  # no walk: the intercept is the mean level
@@ -151,7 +154,7 @@ def _multiscale(per_run: list[tuple[np.ndarray, np.ndarray]]) -> tuple[float, fl
 
 def walk(per_run: list[tuple[np.ndarray, np.ndarray]], b: float) -> float:
     """q_wheel from the heading residuals and window travel of runs (module doc): adjacent block
-    differences at 0.4, 0.8 and 1.6 s; their robust variance grows as a + (q_wheel / b^2) E with
+    differences at 0.4 to 3.2 s; their robust variance grows as a + (q_wheel / b^2) E with
     the travel E they span. The intercept takes the truth's noise, correlated over a window or
     not (a motion-capture heading often is); the slope is the walk."""
     return _multiscale(per_run)[1] * b * b
@@ -177,10 +180,7 @@ def measure(
                 ws[c] = math.sqrt(_multiscale(per)[0] / 3.0)
         bg.window_sigma = ws
         for t in range(T):
-            per_run = [
-                (r[:, 3 * t + 2], it.wtravel[t, 0] + it.wtravel[t, 1])
-                for r, it in zip(res, items, strict=False)
-            ]
+            per_run = unrepeated(items, [r[:, 3 * t + 2] for r in res], t)
             b = items[0].pr.b[t]
             q = walk(per_run, b)
             rng = np.random.default_rng(seed)
@@ -193,6 +193,42 @@ def measure(
     elif mode == "returns":
         bg.spread = np.asarray(sigma, dtype=float)
     return bg
+
+
+def unrepeated(items: list, r: list[np.ndarray], t: int) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Per run: (window residual of truck t less what the other runs of its path show at the
+    same travel, window travel). A floor's walk and the truth's noise differ from run to run; a
+    misfit the candidate leaves because the robot has something else (a gear backlash at every
+    reversal, a diameter that breathes with time, a bump it did not place) repeats on every run
+    of the path, and is not background: the accumulated residual of each run, against its
+    wheels' travel, minus the mean of its path's runs, scaled by sqrt(n / (n - 1)). Paths with
+    a single fitting run cannot tell the two apart and are used as they are only when no path
+    has two."""
+    from .paths import group_key
+
+    travel = [
+        np.concatenate(
+            [[0.0], np.cumsum(it.wtravel[t, 0] + it.wtravel[t, 1])]
+        )  # at the window ends
+        for it in items
+    ]
+    acc = [np.concatenate([[0.0], np.cumsum(x)]) for x in r]
+    paths: dict[str, list[int]] = {}
+    for k, it in enumerate(items):
+        paths.setdefault(group_key(it.pr), []).append(k)
+    out = []
+    for idx in paths.values():
+        if len(idx) < 2:
+            continue
+        n = len(idx)
+        for k in idx:
+            s = travel[k]
+            others = [np.interp(s, travel[j], acc[j]) for j in idx]
+            dev = (acc[k] - np.mean(others, axis=0)) * math.sqrt(n / (n - 1.0))
+            out.append((np.diff(dev), items[k].wtravel[t, 0] + items[k].wtravel[t, 1]))
+    if not out:
+        out = [(x, it.wtravel[t, 0] + it.wtravel[t, 1]) for x, it in zip(r, items, strict=False)]
+    return out
 
 
 def heading_walk_deg_per_sqrt_m(q_wheel: float, b_mm: float) -> float:

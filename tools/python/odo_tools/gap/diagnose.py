@@ -226,6 +226,7 @@ def rank(ds: Dataset, sel: Selection, progress: Progress = None) -> Ranking:
         if progress:
             progress(f"fitting {h.name}")
         singles.append(fit_hypothesis(h, prob, fprs, sig_head))
+    singles = [f for f in singles if _real(f)]
     singles.sort(key=lambda f: f.bic)
     cands = list(singles)
     gof = prob.gof_z({})
@@ -291,6 +292,18 @@ def floor_walk(prob: Problem, vehicle: str) -> Background:
     return measure(prob.items, prob.sigma, prob.mode, P)
 
 
+ROUGH_MIN_MM = 0.05  # a roughness fitted below this is no floor at all
+
+
+def _real(f: Fit) -> bool:
+    """A roughness fitted to (next to) zero height is the nominal noise without the measured
+    walk, not a floor: as a member it would win a pair for the walk's parameter alone (the
+    blind check's slip came out roughness+slip at 0.0 mm)."""
+    return "roughness" not in f.hyp.families or (
+        f.params.get("roughness.max_height_mm", 0.0) >= ROUGH_MIN_MM
+    )
+
+
 def _warm(fits: list[Fit], names: set[str]) -> dict:
     warm = {}
     for f in fits:
@@ -337,7 +350,7 @@ def _pairs(singles, prob, fprs, sig_head, progress) -> list[Fit]:
             other = a if not a.hyp.has_bumps else b
             fb = bumps_for(other)
         out.append(fit_hypothesis(h, prob, fprs, sig_head, fb, _warm(singles, {a.name, b.name})))
-    return out
+    return [f for f in out if _real(f)]
 
 
 def _third(pair: Fit, singles, prob, fprs, sig_head, progress) -> list[Fit]:
@@ -360,7 +373,7 @@ def _third(pair: Fit, singles, prob, fprs, sig_head, progress) -> list[Fit]:
         n += 1
         if n == N_THIRD:
             break
-    return out
+    return [f for f in out if _real(f)]
 
 
 @dataclass
