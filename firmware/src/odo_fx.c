@@ -86,6 +86,83 @@ int64_t odo_mul_s64_s32_shr(int64_t a, int32_t b, unsigned shift)
     return apply_sign(mag, negative);
 }
 
+int64_t odo_mul_s64_u32_shr(int64_t a, uint32_t b, unsigned shift)
+{
+    const uint64_t ua = mag_s64(a);
+    const uint64_t ub = b;
+    /* 96-bit product |a| * b = (hi32 : lo64), rounded on the magnitude as odo_mul_s64_s32_shr. */
+    const uint64_t p_lo = LO32(ua) * ub;
+    const uint64_t p_hi = (ua >> 32) * ub;
+    uint64_t lo = p_lo + (p_hi << 32);
+    uint64_t hi = (p_hi >> 32) + (lo < p_lo ? 1U : 0U);
+    const uint64_t half = (uint64_t)1U << (shift - 1U);
+    const uint64_t lo2 = lo + half;
+    hi += (lo2 < lo) ? 1U : 0U;
+    lo = lo2;
+    const uint64_t mag = (lo >> shift) | (hi << (64U - shift));
+    return apply_sign(mag, a < 0);
+}
+
+/// Leading zero bits of a non-zero value; portable C (five steps), so no compiler builtin.
+static unsigned clz32(uint32_t x)
+{
+    unsigned n = 0U;
+    if ((x & 0xFFFF0000UL) == 0U) {
+        n += 16U;
+        x <<= 16;
+    }
+    if ((x & 0xFF000000UL) == 0U) {
+        n += 8U;
+        x <<= 8;
+    }
+    if ((x & 0xF0000000UL) == 0U) {
+        n += 4U;
+        x <<= 4;
+    }
+    if ((x & 0xC0000000UL) == 0U) {
+        n += 2U;
+        x <<= 2;
+    }
+    return ((x & 0x80000000UL) == 0U) ? n + 1U : n;
+}
+
+/// One 16-bit quotient digit of (u * 2^16) / vn for u < vn, vn normalised (top bit set): the
+/// estimate u / vn1 is at most 2 too large and corrected with the next divisor digit vn0
+/// (Knuth, TAOCP vol. 2, 4.3.1, algorithm D, step D3). *rem gets the remainder, in [0, vn).
+static uint32_t div_digit(uint32_t u, uint32_t vn, uint32_t *rem)
+{
+    const uint32_t vn1 = vn >> 16, vn0 = vn & 0xFFFFU;
+    uint32_t q = u / vn1;
+    uint32_t rhat = u - q * vn1;
+    while (q > 0xFFFFU || q * vn0 > (rhat << 16)) {
+        q--;
+        rhat += vn1;
+        if (rhat > 0xFFFFU) {
+            break;
+        }
+    }
+    /* u * 2^16 - q * vn is the true remainder, in [0, vn): exact modulo 2^32. */
+    *rem = (u << 16) - q * vn;
+    return q;
+}
+
+uint32_t odo_frac_q32(uint32_t n, uint32_t d)
+{
+    if (n >= d) {
+        return UINT32_MAX; /* also d == 0 */
+    }
+    /* Scale both so d's top bit is set: the quotient is unchanged, n << s < d << s fits. */
+    const unsigned s = clz32(d);
+    const uint32_t vn = d << s;
+    uint32_t r1, r0;
+    const uint32_t q1 = div_digit(n << s, vn, &r1);
+    const uint32_t q0 = div_digit(r1, vn, &r0);
+    const uint32_t q = (q1 << 16) | q0;
+    /* Round half up on the remainder: r0 / vn >= 1/2. q + 1 cannot wrap: n < d gives
+     * n * 2^32 / d <= 2^32 - 2^32 / d < 2^32 - 1. */
+    return (r0 >= vn - r0) ? q + 1U : q;
+}
+
 int64_t odo_shr_round_s64(int64_t v, unsigned shift)
 {
     const uint64_t mag = mag_s64(v);

@@ -10,6 +10,7 @@
 #define INV_2PI_Q64 2935890503282001226ULL
 
 #define Q30_ONE_U ((uint64_t)1U << 30)
+#define SCRUB_MAX_Q30 ((int32_t)ODO_SCRUB_MAX_Q30)
 #define NM_PER_MM 1000000U
 
 /* Heading bookkeeping reads a per-tick heading change as a signed fraction of a turn, which is
@@ -29,7 +30,9 @@ odo_model_status_t odo_model_init(odo_model_t *m, const odo_truck_params_t *tp, 
     const uint64_t eb = (uint64_t)(uint32_t)tp->eb_q30;
     const uint64_t es = (uint64_t)(uint32_t)tp->es_q30;
     if (tp->ed_q30 <= 0 || tp->eb_q30 <= 0 || tp->es_q30 <= 0 || tp->wheelbase_nm == 0U ||
-        tp->counts_per_rev_milli == 0U || counter_bits < 2U || counter_bits > 32U) {
+        tp->counts_per_rev_milli == 0U || counter_bits < ODO_COUNTER_BITS_MIN ||
+        counter_bits > ODO_COUNTER_BITS_MAX || tp->scrub_q30 < -SCRUB_MAX_Q30 ||
+        tp->scrub_q30 > SCRUB_MAX_Q30) {
         return ODO_MODEL_ERR_RANGE;
     }
 
@@ -88,6 +91,12 @@ odo_model_status_t odo_model_init(odo_model_t *m, const odo_truck_params_t *tp, 
             return ODO_MODEL_ERR_RANGE;
         }
     }
+    /* k * turn per count for the scrub term. turn * max_counts < 2^62 (checked above) and
+     * |k| <= 1/4, so k * turn * |delta| stays below 2^60 for every accepted delta. */
+    for (unsigned w = 0U; w < 2U; ++w) {
+        mm.scrub_turn_q64[w] = (uint64_t)odo_mul_s64_s32_shr((int64_t)mm.turn_q64[w], tp->scrub_q30, 30U);
+    }
+    mm.scrub_q30 = tp->scrub_q30;
     mm.max_counts = (uint32_t)max_counts;
     mm.counter_bits = counter_bits;
     mm.invert = tp->flags;
@@ -123,6 +132,24 @@ static int64_t as_signed(uint64_t u)
 
 /// |v| as unsigned; exact for INT32_MIN.
 static uint32_t mag32(int32_t v) { return v < 0 ? 0U - (uint32_t)v : (uint32_t)v; }
+
+int64_t odo_scrub_dturn(const odo_model_t *m, int32_t d_left, int32_t d_right)
+{
+    const int32_t d[2] = {d_left, d_right};
+    if ((int64_t)d[0] * d[1] <= 0) {
+        return 0; /* a spot turn, a pivot on one wheel or a stop: m = 0 */
+    }
+    const uint32_t a = mag32(d[0]), b = mag32(d[1]);
+    const uint32_t v = a + b;                 /* < 2^32 */
+    const uint32_t mv = 2U * (a < b ? a : b); /* <= v */
+    /* k * dtheta from the k-scaled multipliers, with the same exact modular sum as Eq. 2.4. */
+    const int64_t k_dturn = as_signed(m->scrub_turn_q64[1] * (uint64_t)(int64_t)d[1] -
+                                      m->scrub_turn_q64[0] * (uint64_t)(int64_t)d[0]);
+    if (mv == v) {
+        return k_dturn; /* equal wheels: m / v = 1 (does not fit Q32) */
+    }
+    return odo_mul_s64_u32_shr(k_dturn, odo_frac_q32(mv, v), 32U);
+}
 
 void odo_truck_step(odo_truck_t *t, const odo_model_t *m, uint32_t left_raw, uint32_t right_raw,
                     uint8_t bits, odo_step_t *out)
@@ -168,7 +195,10 @@ void odo_truck_step(odo_truck_t *t, const odo_model_t *m, uint32_t left_raw, uin
     /* Eq. 2.4 in turns: modular arithmetic on uint64 is exact; each term is below 2^62. */
     const uint64_t dturn_u = m->turn_q64[1] * (uint64_t)(int64_t)d[1] -
                              m->turn_q64[0] * (uint64_t)(int64_t)d[0];
-    const int64_t dturn = as_signed(dturn_u);
+    int64_t dturn = as_signed(dturn_u);
+    if (m->scrub_q30 != 0) {
+        dturn -= odo_scrub_dturn(m, d[0], d[1]); /* g = 1 - k m / v; |k m / v| <= 1/4: no overflow */
+    }
 
     odo_pose_advance(&t->pose, dist, dturn, m->heading_form);
     out->dist_mm_q40 = dist;

@@ -3,10 +3,12 @@
 ///
 ///   gen_param_block OUT.c
 ///
-/// writes OUT.c, a C file defining odo_param_block (odo_board.h) as the 128 bytes of
-/// odo_params_encode(odo_params_defaults()), placed in section .odo_params. The C preprocessor
-/// cannot compute the CRC-32, and the firmware's own codec is the single source of truth for the
-/// layout, so the block is produced by that codec rather than written out by hand.
+/// writes OUT.c, a C file defining odo_param_block (odo_board.h) as the ODO_PARAMS_SIZE bytes
+/// (256, version 2) of odo_params_encode(odo_params_defaults()), placed in section .odo_params,
+/// and the absolute symbol __odo_params_block_size = ODO_PARAMS_SIZE, which the linker script
+/// (odo_cm4.ld) checks the section's size against. The C preprocessor cannot compute the CRC-32,
+/// and the firmware's own codec is the single source of truth for the layout, so the block (and
+/// its size, for the linker) is produced by that codec rather than written out by hand.
 ///
 /// The layout is explicit little-endian, so a block encoded on the host is the block the target
 /// reads. Before writing, the block is decoded back and must be ODO_PARAMS_OK; otherwise (or on any
@@ -61,8 +63,11 @@ int main(int argc, char **argv)
             " * Do not edit: change the defaults in firmware/src/odo_params.c, or patch a built image\n"
             " * with `odo-calib write`. Layout: firmware/include/odo/odo_params.h. */\n"
             "#include \"odo_board.h\"\n\n"
+            "/* The block's size as a link-time constant, for odo_cm4.ld's ASSERT on .odo_params. */\n"
+            "__asm__(\".global __odo_params_block_size\\n\\t.set __odo_params_block_size, %u\");\n\n"
             "__attribute__((section(\".odo_params\"), used, aligned(4)))\n"
-            "const uint8_t odo_param_block[ODO_PARAMS_SIZE] = {\n");
+            "const uint8_t odo_param_block[ODO_PARAMS_SIZE] = {\n",
+            ODO_PARAMS_SIZE);
     for (size_t i = 0; i < sizeof block; ++i) {
         fprintf(f, "%s0x%02XU,%s", (i % 12U) == 0U ? "    " : " ", (unsigned)block[i],
                 ((i % 12U) == 11U || i + 1U == sizeof block) ? "\n" : "");

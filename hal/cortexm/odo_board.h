@@ -18,7 +18,7 @@ extern "C" {
 /// The parameter block in flash: section .odo_params, fixed at 0x08004000 (flash sector 1) by
 /// odo_cm4.ld. Defined in the build-generated odo_param_block.c (gen_param_block.c writes it from
 /// odo_params_defaults() with a valid magic, version, length and CRC-32); `odo-calib write`
-/// replaces those 128 bytes in the .bin/.hex or on the part. Defined in its own translation unit
+/// replaces those ODO_PARAMS_SIZE (256) bytes in the .bin/.hex or on the part. Defined in its own translation unit
 /// so the compiler can never fold its contents into main(): the firmware reads what is in flash.
 extern const uint8_t odo_param_block[ODO_PARAMS_SIZE];
 

@@ -328,6 +328,7 @@ int main(int argc, char **argv)
             robot.truck[t].cal_ed = c->ed_q30 / 1073741824.0;
             robot.truck[t].cal_eb = c->eb_q30 / 1073741824.0;
             robot.truck[t].cal_es = c->es_q30 / 1073741824.0;
+            robot.truck[t].cal_scrub = c->scrub_q30 / 1073741824.0;
             robot.truck[t].has_calibration = true;
         }
     }

@@ -46,6 +46,7 @@ static void labmate_truck(sim_truck_desc_t *t)
     t->counter_bits = 24U;
     t->decoder = SIM_DECODER_HCTL1100;
     t->cal_ed = t->cal_eb = t->cal_es = 1.0;
+    t->cal_scrub = 0.0;
 }
 
 /* The papers give no trailer dimensions; these are assumed (README "where the papers are loose"):
@@ -259,7 +260,7 @@ static int parse_truck(const ctx_t *c, const json_t *o, const char *path, sim_tr
                                        "counter_bits", "decoder", "invert_left", "invert_right",
                                        "calibration", NULL};
     static const char *const decoders[] = {"hctl1100", "hctl20xx", NULL};
-    static const char *const cal_keys[] = {"ed", "eb", "es", NULL};
+    static const char *const cal_keys[] = {"ed", "eb", "es", "scrub", NULL};
     unsigned dec = (unsigned)t->decoder;
     /* Ranges are the firmware's (odo_params.h) so a file that parses also validates. */
     if (only_keys(c, o, path, keys) != 0 ||
@@ -292,7 +293,9 @@ static int parse_truck(const ctx_t *c, const json_t *o, const char *path, sim_tr
         field(f, sizeof f, path, "calibration");
         if (only_keys(c, cal, f, cal_keys) != 0 || get_num(c, cal, f, "ed", false, 0.8, 1.25, &t->cal_ed) != 0 ||
             get_num(c, cal, f, "eb", false, 0.8, 1.25, &t->cal_eb) != 0 ||
-            get_num(c, cal, f, "es", false, 0.8, 1.25, &t->cal_es) != 0) {
+            get_num(c, cal, f, "es", false, 0.8, 1.25, &t->cal_es) != 0 ||
+            /* k of the firmware's tyre-scrub term (odo_odometry.h): |k| <= 0.25, as the block */
+            get_num(c, cal, f, "scrub", false, -0.25, 0.25, &t->cal_scrub) != 0) {
             return -1;
         }
         t->has_calibration = true;
@@ -500,6 +503,7 @@ static const char *json_field(const sim_robot_t *r, odo_param_field_t f)
     case ODO_PF_ED: return "calibration.ed";
     case ODO_PF_EB: return "calibration.eb";
     case ODO_PF_ES: return "calibration.es";
+    case ODO_PF_SCRUB: return "calibration.scrub";
     case ODO_PF_TRUCK_FLAGS: return "invert_left/invert_right";
     case ODO_PF_LINK_LENGTH: return r->vehicle == SIM_VEHICLE_SET ? "trailer.trailer_length_mm" : "linkage.length_mm";
     case ODO_PF_HITCH_OFFSET: return "trailer.hitch_offset_mm";
@@ -511,6 +515,8 @@ static const char *json_field(const sim_robot_t *r, odo_param_field_t f)
     case ODO_PF_STALE_TICKS: return "(stale_ticks)";
     case ODO_PF_MAX_JUMP: return "(max_jump)";
     case ODO_PF_MAX_LENGTH_JUMP: return "(max_length_jump)";
+    case ODO_PF_LENGTH_MIN:
+    case ODO_PF_LENGTH_MAX:
     case ODO_PF_LENGTH_RANGE: return "linkage.range_mm";
     case ODO_PF_NONE:
     case ODO_PF_RESERVED: break;
@@ -544,6 +550,7 @@ int sim_robot_to_params(const sim_robot_t *r, odo_params_t *p, char *err, size_t
         tp->ed_q30 = sat_i32(d->cal_ed * TWO30);
         tp->eb_q30 = sat_i32(d->cal_eb * TWO30);
         tp->es_q30 = sat_i32(d->cal_es * TWO30);
+        tp->scrub_q30 = sat_i32(d->cal_scrub * TWO30);
         tp->flags = (uint8_t)((d->invert_left ? ODO_TRUCK_INVERT_LEFT : 0U) |
                               (d->invert_right ? ODO_TRUCK_INVERT_RIGHT : 0U));
     }
@@ -567,7 +574,7 @@ int sim_robot_to_params(const sim_robot_t *r, odo_params_t *p, char *err, size_t
     odo_param_field_t bad = ODO_PF_NONE;
     uint8_t bad_truck = 0U;
     if (odo_params_validate(p, &bad, &bad_truck) != ODO_PARAMS_OK) {
-        const bool truck_field = bad >= ODO_PF_WHEEL_DIAMETER && bad <= ODO_PF_TRUCK_FLAGS;
+        const bool truck_field = odo_params_field_is_truck(bad);
         char f[160];
         snprintf(f, sizeof f, "%s%s%s", truck_field ? "trucks." : "",
                  truck_field ? (bad_truck == 0U ? "A." : "B.") : "", json_field(r, bad));

@@ -13,7 +13,8 @@
 ///       "A": {"wheel_diameter_mm": 150, "wheelbase_mm": 340, "encoder_lines": 500,
 ///             "gear_ratio": 19.5, "counter_bits": 24, "decoder": "hctl1100",
 ///             "invert_left": false, "invert_right": false,
-///             "calibration": {"ed": 1.0, "eb": 1.0, "es": 1.0}},      optional (UMBmark result)
+///             "calibration": {"ed": 1.0, "eb": 1.0, "es": 1.0,           optional (UMBmark result)
+///                             "scrub": 0.0}},            optional, k of the tyre-scrub term, |k| <= 0.25
 ///       "B": {...}                                     clapper: rear truck; set: the trailer
 ///     },
 ///     "linkage": {"length_mm": 1000, "range_mm": [900, 1100], "rotary_bits": 10,
@@ -53,6 +54,7 @@ typedef struct {
     bool          invert_left;       ///< left counter counts down when the wheel rolls forward
     bool          invert_right;
     double        cal_ed, cal_eb, cal_es; ///< calibration block (1.0 when absent)
+    double        cal_scrub;         ///< k of the firmware's tyre-scrub term (0 when absent)
     bool          has_calibration;
 } sim_truck_desc_t;
 

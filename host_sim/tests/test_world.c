@@ -608,6 +608,25 @@ START_TEST(robot_descriptions_convert_to_parameter_blocks_the_firmware_accepts)
     ck_assert_int_eq(p.truck[0].ed_q30, (int32_t)llround(1.0015 * 1073741824.0));
     ck_assert_int_eq(p.truck[0].eb_q30, (int32_t)llround(0.99 * 1073741824.0));
     ck_assert_int_eq(p.truck[0].es_q30, ODO_RATIO_Q30_ONE);
+    ck_assert_int_eq(p.truck[0].scrub_q30, 0);
+
+    /* ... and "scrub", k of the firmware's tyre-scrub term, in scrub_q30 (|k| <= 0.25). */
+    must(sim_robot_parse_string("{\"vehicle\": \"labmate\", \"trucks\": {\"A\": {\"wheel_diameter_mm\": 150, "
+                                "\"wheelbase_mm\": 340, \"encoder_lines\": 500, \"gear_ratio\": 19.5, "
+                                "\"calibration\": {\"eb\": 1.0065, \"scrub\": -0.0095}}}}",
+                                "scrub.json", &r, err, sizeof err), err);
+    must(sim_robot_to_params(&r, &p, err, sizeof err), err);
+    ck_assert_int_eq(p.truck[0].scrub_q30, (int32_t)llround(-0.0095 * 1073741824.0));
+    ck_assert_int_eq(p.truck[0].eb_q30, (int32_t)llround(1.0065 * 1073741824.0));
+    ck_assert_int_ne(sim_robot_parse_string("{\"vehicle\": \"labmate\", \"trucks\": {\"A\": {\"wheel_diameter_mm\": "
+                                            "150, \"wheelbase_mm\": 340, \"encoder_lines\": 500, \"gear_ratio\": "
+                                            "19.5, \"calibration\": {\"scrub\": 0.3}}}}",
+                                            "scrub.json", &r, err, sizeof err), 0);
+    ck_assert_ptr_nonnull(strstr(err, "trucks.A.calibration.scrub"));
+    load_robot("labmate", &r);
+    r.truck[0].cal_scrub = -0.26; /* built in code: caught by odo_params_validate, named */
+    ck_assert_int_eq(sim_robot_to_params(&r, &p, err, sizeof err), -1);
+    ck_assert_ptr_nonnull(strstr(err, "trucks.A.calibration.scrub"));
 
     /* An out-of-range value built in code is caught by odo_params_validate and named. */
     load_robot("labmate", &r);

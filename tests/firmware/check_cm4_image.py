@@ -4,12 +4,14 @@
 Configures and builds the cm4 preset from the source tree (`cmake --preset cm4`, `cmake --build
 --preset cm4`, into build/cm4; independent of the host build), then checks:
 
-  * section .odo_params is at the fixed flash address, 128 bytes, alone in its erase sector,
-    and the linker's __odo_params_start/__odo_params_size agree;
-  * its bytes are a valid parameter block: "ODOP", version 1, length 128, CRC-32 (zlib) of the
-    first 124 bytes in the last 4 (little-endian), as odo/odo_params.h specifies;
-  * odo_image.bin holds the same 128 bytes at (address - flash base), so `odo-calib write` can find
+  * section .odo_params is at the fixed flash address, one block's size, alone in its erase
+    sector, and the linker's __odo_params_start/__odo_params_size agree;
+  * its bytes are a valid parameter block: "ODOP", the current version and length, CRC-32 (zlib)
+    of all but the last 4 bytes in the last 4 (little-endian), as odo/odo_params.h specifies;
+  * odo_image.bin holds the same bytes at (address - flash base), so `odo-calib write` can find
     it by magic in a raw image; odo_image.hex exists;
+The block's size, version and CRC offset are read from `odo-params layout` (--layout), which
+expands odo_params.h's field table, so this check holds no copy of them.
   * no soft-float, heap or stdio symbol is linked;
 and prints the text/data/bss sizes. Exit 0 on success, 1 with the reasons on failure.
 """
@@ -17,6 +19,7 @@ and prints the text/data/bss sizes. Exit 0 on success, 1 with the reasons on fai
 from __future__ import annotations
 
 import argparse
+import json
 import re
 import shutil
 import struct
@@ -40,8 +43,6 @@ FORBIDDEN_SYMBOLS = [
 ]
 
 ODOP = b"ODOP"
-PARAMS_VERSION = 1
-CRC_OFFSET = 124
 
 
 def run(
@@ -106,7 +107,12 @@ def main() -> int:
     ap.add_argument("--source-dir", type=Path, required=True)
     ap.add_argument("--cmake", default="cmake")
     ap.add_argument("--params-addr", type=lambda s: int(s, 0), default=0x08004000)
-    ap.add_argument("--params-size", type=lambda s: int(s, 0), default=128)
+    ap.add_argument(
+        "--layout",
+        type=Path,
+        required=True,
+        help="params_layout.json written by `odo-params layout` (the host build)",
+    )
     ap.add_argument("--params-sector-size", type=lambda s: int(s, 0), default=0x4000)
     ap.add_argument("--flash-base", type=lambda s: int(s, 0), default=0x08000000)
     ap.add_argument(
@@ -142,7 +148,13 @@ def main() -> int:
             return 1
 
     errors: list[str] = []
-    addr, want_size = args.params_addr, args.params_size
+    try:
+        layout = json.loads(args.layout.read_text())
+    except (OSError, ValueError) as e:
+        print(f"firmware.cm4_image FAILED: cannot read the layout {args.layout}: {e}")
+        return 1
+    addr, want_size = args.params_addr, layout["size"]
+    params_version, crc_offset = layout["version"], layout["crc_offset"]
 
     secs = sections(objdump, elf)
     sec = secs.get(".odo_params")
@@ -213,13 +225,13 @@ def main() -> int:
         else:
             magic = block[0:4]
             version, length = struct.unpack_from("<HH", block, 4)
-            (crc_stored,) = struct.unpack_from("<I", block, CRC_OFFSET)
-            crc = zlib.crc32(block[:CRC_OFFSET]) & 0xFFFFFFFF
+            (crc_stored,) = struct.unpack_from("<I", block, crc_offset)
+            crc = zlib.crc32(block[:crc_offset]) & 0xFFFFFFFF
             if magic != ODOP:
                 errors.append(f"parameter block magic is {magic!r}, must be {ODOP!r}")
-            if version != PARAMS_VERSION:
+            if version != params_version:
                 errors.append(
-                    f"parameter block version is {version}, must be {PARAMS_VERSION}"
+                    f"parameter block version is {version}, must be {params_version}"
                 )
             if length != want_size:
                 errors.append(
@@ -228,7 +240,7 @@ def main() -> int:
             if crc_stored != crc:
                 errors.append(
                     f"parameter block CRC field is {crc_stored:#010x}, but "
-                    f"zlib.crc32(block[:{CRC_OFFSET}]) is {crc:#010x}"
+                    f"zlib.crc32(block[:{crc_offset}]) is {crc:#010x}"
                 )
             print(
                 f"parameter block at {addr:#010x}: magic {magic!r} version {version} "

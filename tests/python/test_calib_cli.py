@@ -22,6 +22,12 @@ SIM = BIN / "odo-sim"
 ROBOT = SRC / "host_sim" / "robots" / "labmate.json"
 SET_SIM = SRC / "host_sim" / "scenarios" / "set-sim.json"
 HEADER = "run,direction,x_abs_mm,y_abs_mm,theta_abs_deg,x_calc_mm,y_calc_mm,theta_calc_deg\n"
+# The parameter block's layout as odo_params.h's field table gives it (odo-params layout).
+LAYOUT = json.loads(
+    Path(os.environ.get("ODO_PARAMS_LAYOUT") or BUILD / "params_layout.json").read_text())
+SIZE, CRC = LAYOUT["size"], LAYOUT["crc_offset"]
+(V1,) = [v for v in LAYOUT["versions"] if v["version"] == 1]
+NEW_IN_V2 = [f for f in LAYOUT["fields"] if f["since"] == 2]  # scrub_q30
 
 
 def run(*args: object, timeout: int = 600) -> subprocess.CompletedProcess[str]:
@@ -187,9 +193,34 @@ def calibrated_params(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
 
 def block_of(data: bytes, at: int) -> bytes:
-    b = data[at:at + 128]
-    assert b[:4] == b"ODOP" and zlib.crc32(b[:124]) == int.from_bytes(b[124:], "little")
+    b = data[at:at + SIZE]
+    assert b[:4] == b"ODOP" and zlib.crc32(b[:CRC]) == int.from_bytes(b[CRC:], "little")
     return b
+
+
+def elf_block(data: bytes) -> bytes:
+    """The version-2 block in an image (found by its magic and version, checked by its CRC)."""
+    return block_of(data, data.index(b"ODOP" + LAYOUT["version"].to_bytes(2, "little")))
+
+
+def v1_json(params: Path, out: Path) -> Path:
+    """The params file as tools before layout version 2 wrote it: version 1, length 128, no
+    scrub_q30."""
+    j = json.loads(params.read_text())
+    j["version"], j["length"] = 1, V1["size"]
+    for t in j["truck"]:
+        for f in NEW_IN_V2:
+            del t[f["name"]]
+    out.write_text(json.dumps(j))
+    return out
+
+
+def v1_block(block: bytes) -> bytes:
+    """A version-1 block from a version-2 one, by the header's rule (same bytes up to the
+    version-1 CRC; version 1, length 128, CRC-32 of those bytes)."""
+    b = bytearray(block[:V1["crc_offset"]])
+    b[4:8] = (1).to_bytes(2, "little") + V1["size"].to_bytes(2, "little")
+    return bytes(b) + zlib.crc32(bytes(b)).to_bytes(4, "little")
 
 
 def check_written(image: Path, out: Path, params: Path, fmt: str) -> None:
@@ -212,7 +243,7 @@ def test_write_read_a_host_elf_with_an_odo_params_section(tmp_path: Path,
     # the patched program boots with the new block (the firmware's own boot rule)
     r = run(tmp_path / "patched")
     assert r.returncode == 0 and r.stdout.split() == ["ok", str(round(0.9985 * 2**30)),
-                                                      str(round(337 / 340 * 2**30))]
+                                                      str(round(337 / 340 * 2**30)), "0"]
     # in place (no --out) keeps the file mode, so it still runs
     assert run(CALIB, "write", "--image", fx, "--params", calibrated_params).returncode == 0
     assert run(fx).returncode == 0
@@ -245,7 +276,7 @@ def test_write_read_the_cortex_m4_image(tmp_path: Path, cm4_image: Path, calibra
     assert len(old) == len(new)
     if ext == "bin":  # only the block changed, at 0x08004000 - 0x08000000
         diff = [i for i in range(len(old)) if old[i] != new[i]]
-        assert diff and min(diff) >= 0x4000 and max(diff) < 0x4080
+        assert diff and min(diff) >= 0x4000 and max(diff) < 0x4000 + SIZE
         assert block_of(new, 0x4000) != block_of(old, 0x4000)
     if ext == "elf" and cross_tool("arm-none-eabi-objcopy"):
         # binutils agrees: the patched ELF's .odo_params is the block we wrote into the .bin
@@ -263,10 +294,12 @@ def test_wrong_version_truncated_and_read_only_images_are_refused(tmp_path: Path
     assert run(BIN / "odo-params", "defaults", "--out", default).returncode == 0
     good = bytes(64) + default.read_bytes() + bytes(64)
     cases = {}
-    v2 = bytearray(good)
-    v2[64 + 4] = 2
-    v2[64 + 124:64 + 128] = zlib.crc32(bytes(v2[64:64 + 124])).to_bytes(4, "little")
-    cases["version.bin"] = (bytes(v2), "layout version 2")
+    v3 = bytearray(good)
+    v3[64 + 4] = LAYOUT["version"] + 1
+    v3[64 + CRC:64 + SIZE] = zlib.crc32(bytes(v3[64:64 + CRC])).to_bytes(4, "little")
+    cases["version.bin"] = (bytes(v3), f"layout version {LAYOUT['version'] + 1}")
+    cases["v1.bin"] = (bytes(64) + v1_block(default.read_bytes()) + bytes(64),
+                       "version-1 parameter block (128 bytes)")
     cases["trunc.bin"] = (good[:64 + 100], "truncated")
     bad_crc = bytearray(good)
     bad_crc[64 + 20] ^= 1
@@ -283,7 +316,8 @@ def test_wrong_version_truncated_and_read_only_images_are_refused(tmp_path: Path
         assert img.read_bytes() == data and not out.exists(), name
         r = run(CALIB, "write", "--image", img, "--params", calibrated_params)
         assert r.returncode == 1 and img.read_bytes() == data, name
-        assert run(CALIB, "verify", "--image", img).returncode == 1, name
+        if name != "v1.bin":  # a version-1 image is valid, it just cannot take version 2
+            assert run(CALIB, "verify", "--image", img).returncode == 1, name
     img = tmp_path / "ok.bin"
     img.write_bytes(good)
     r = run(CALIB, "write", "--image", img, "--params", calibrated_params,
@@ -333,3 +367,102 @@ def test_acceptance_seeded_subset_meets_the_targets() -> None:
     e7, e8 = j["tape"]
     assert e7["experiment"] == "E-7" and e7["exact_after_mm"][0] <= 3 * e7["sem_after_exact_mm"]
     assert e8["emax_before_mm"] / e8["exact_after_mm"][0] >= 20
+
+
+# --------------------------------------------------------------------------------------------
+# Parameter block version 2: the scrub term, and version-1 files and images
+# --------------------------------------------------------------------------------------------
+
+def test_version_1_params_json_and_block_upgrade_a_version_2_image(tmp_path: Path,
+                                                                   calibrated_params: Path) -> None:
+    """A params file written before version 2 (JSON or raw block) goes into a version-2 image as
+    version 2 with scrub_q30 = 0 and every other field as it was; the image boots on it."""
+    old_json = v1_json(calibrated_params, tmp_path / "old.json")
+    fx = tmp_path / "fixture"
+    shutil.copy(BUILD / "tests" / "odo-calib-fixture-elf", fx)
+    elf = tmp_path / "cal.elf"
+    assert run(CALIB, "write", "--image", fx, "--params", calibrated_params, "--out", elf
+               ).returncode == 0
+    cal_bin = tmp_path / "cal.bin"
+    cal_bin.write_bytes(v1_block(elf_block(elf.read_bytes())))
+    want = json.loads(calibrated_params.read_text())
+    for src in (old_json, cal_bin):
+        out = tmp_path / f"from-{src.suffix[1:]}"
+        r = run(CALIB, "write", "--image", fx, "--params", src, "--out", out)
+        assert r.returncode == 0, r.stderr
+        assert "version-2" in r.stderr
+        j = json.loads(run(CALIB, "read", "--image", out, "--json").stdout)
+        assert (j["version"], j["length"]) == (LAYOUT["version"], SIZE)
+        assert j["truck"] == want["truck"] and j["link"] == want["link"]
+        assert [t["scrub_q30"] for t in j["truck"]] == [0, 0]
+        r = run(out)  # the firmware's boot rule on the upgraded block
+        assert r.returncode == 0 and r.stdout.split()[0] == "ok" and r.stdout.split()[3] == "0"
+    # version-1 JSON must not carry version-2 fields, and version 2 must carry them
+    j = json.loads(old_json.read_text())
+    j["truck"][1]["scrub_q30"] = 0
+    bad = tmp_path / "v1-with-scrub.json"
+    bad.write_text(json.dumps(j))
+    r = run(CALIB, "write", "--image", fx, "--params", bad, "--out", tmp_path / "x")
+    assert r.returncode == 1 and "truck[1].scrub_q30: not part of a version-1 block" in r.stderr
+    j = json.loads(calibrated_params.read_text())
+    del j["truck"][0]["scrub_q30"]
+    bad.write_text(json.dumps(j))
+    r = run(CALIB, "write", "--image", fx, "--params", bad, "--out", tmp_path / "x")
+    assert r.returncode == 1 and "truck[0].scrub_q30: missing" in r.stderr
+    assert not (tmp_path / "x").exists()
+
+
+def test_scrub_goes_into_the_image_and_out_of_range_is_refused(tmp_path: Path,
+                                                              calibrated_params: Path) -> None:
+    k = round(0.0095 * 2**30)  # the OptiOdom robot's tyre scrub
+    j = json.loads(calibrated_params.read_text())
+    j["truck"][0]["scrub_q30"] = k
+    j["truck"][1]["scrub_q30"] = -k
+    p = tmp_path / "scrub.json"
+    p.write_text(json.dumps(j))
+    fx = tmp_path / "fixture"
+    shutil.copy(BUILD / "tests" / "odo-calib-fixture-elf", fx)
+    assert run(CALIB, "write", "--image", fx, "--params", p).returncode == 0
+    r = run(fx)
+    assert r.returncode == 0 and r.stdout.split()[3] == str(k)
+    got = json.loads(run(CALIB, "read", "--image", fx, "--json").stdout)
+    assert [t["scrub_q30"] for t in got["truck"]] == [k, -k]
+    assert "scrub k 0.0095000" in run(CALIB, "read", "--image", fx).stdout
+    (scrub,) = NEW_IN_V2
+    before = fx.read_bytes()
+    for value in (scrub["max"] + 1, scrub["min"] - 1):
+        j["truck"][1]["scrub_q30"] = value
+        p.write_text(json.dumps(j))
+        r = run(CALIB, "write", "--image", fx, "--params", p)
+        assert r.returncode == 1 and "truck[1].scrub_q30" in r.stderr and fx.read_bytes() == before
+    # an image whose block holds an out-of-range scrub (CRC good): verify and read name it
+    data = bytearray(before)
+    at = data.index(elf_block(before))
+    off = at + scrub["offsets"][1]
+    data[off:off + 4] = (scrub["max"] + 1).to_bytes(4, "little")
+    data[at + CRC:at + SIZE] = zlib.crc32(bytes(data[at:at + CRC])).to_bytes(4, "little")
+    bad = tmp_path / "bad.elf"
+    bad.write_bytes(bytes(data))
+    for cmd in ("verify", "read"):
+        r = run(CALIB, cmd, "--image", bad)
+        want = f"truck[1].scrub_q30 = {scrub['max'] + 1}"
+        assert r.returncode == 1 and want in r.stderr, r.stderr
+
+
+def test_a_version_1_image_reads_and_verifies_but_is_never_written(tmp_path: Path,
+                                                                   calibrated_params: Path) -> None:
+    default = tmp_path / "d.bin"
+    assert run(BIN / "odo-params", "defaults", "--out", default).returncode == 0
+    data = bytes(range(256)) * 64 + v1_block(default.read_bytes()) + b"\xff" * 512
+    img = tmp_path / "old.bin"
+    img.write_bytes(data)
+    r = run(CALIB, "verify", "--image", img)
+    assert r.returncode == 0 and "version 1" in r.stdout, r.stderr
+    j = json.loads(run(CALIB, "read", "--image", img, "--json").stdout)
+    assert (j["version"], j["length"]) == (1, V1["size"])
+    assert all(f["name"] not in j["truck"][0] for f in NEW_IN_V2)
+    r = run(CALIB, "write", "--image", img, "--params", calibrated_params)
+    assert r.returncode == 1 and "version-1 parameter block (128 bytes)" in r.stderr
+    r = run(CALIB, "write", "--image", img, "--params", calibrated_params, "--force")
+    assert r.returncode == 1 and img.read_bytes() == data
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["d.bin", "old.bin"]

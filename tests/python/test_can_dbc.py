@@ -299,7 +299,7 @@ def test_status_param_state_names_follow_odo_params_status(db: Database) -> None
     sig = db.get_message_by_name("STATUS").get_signal_by_name("ParamState")
     assert sig.choices is not None and str(sig.choices[0]) == "OK"
     header = (SOURCE_DIR / "firmware" / "include" / "odo" / "odo_params.h").read_text()
-    enum_body = re.search(r"typedef enum \{(.*?)\} odo_params_status_t;", header, re.DOTALL)
+    enum_body = re.search(r"typedef enum \{([^{}]*)\} odo_params_status_t;", header)
     assert enum_body is not None
     names = re.findall(r"ODO_PARAMS_(\w+)", enum_body.group(1))
     assert [str(sig.choices[i]) for i in range(len(names))] == names

@@ -106,3 +106,27 @@ def test_effects_catalog_is_published_as_json(lib: C.CDLL) -> None:
     for name in ("ed", "eb", "es", "bumps", "roughness", "slip", "skid", "count_loss",
                  "rotary_bias", "link_bias", "tire_compression"):
         assert f'"{name}"' in text, name
+
+
+def test_the_robot_calibration_scrub_reaches_the_firmware(lib: C.CDLL, tmp_path: Path) -> None:
+    """A robot description's "scrub" (k of the firmware's tyre-scrub term) is what the firmware in
+    the loop believes: on the rectangle, whose corners the follower drives as arcs, the firmware's
+    heading and so the driven path change; k = 0 is the file without the key, bit for bit."""
+    robot = json.loads((SRC / "host_sim/robots/labmate.json").read_text())
+    results = {}
+    for k in (None, 0.0, 0.2):
+        r = json.loads(json.dumps(robot))
+        if k is not None:
+            r["trucks"]["A"]["calibration"] = {"scrub": k}
+        path = tmp_path / f"robot-{k}.json"
+        path.write_text(json.dumps(r))
+        err = C.create_string_buffer(512)
+        s = lib.odosim_setup_load(str(path).encode(),
+                                  str(SRC / "host_sim/scenarios/none.json").encode(), err, 512)
+        assert s, err.value.decode()
+        res = Result()
+        assert lib.odosim_run(s, b"rect-7x4", 0, -1, 0, 1, 0, None, 0, C.byref(res), err, 512) == 0
+        lib.odosim_setup_free(s)
+        results[k] = (res.x_abs_mm, res.y_abs_mm, res.theta_calc_deg)
+    assert results[None] == results[0.0]
+    assert math.dist(results[0.2][:2], results[0.0][:2]) > 100.0

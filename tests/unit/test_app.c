@@ -185,6 +185,45 @@ static void step_is_deterministic_for_identical_inputs(void)
     TEST_ASSERT_EQUAL_MEMORY(&a.truck, &b.truck, sizeof a.truck);
 }
 
+/// A 12-bit decoder behind 24-bit CAN frames (the OptiOdom robot's width): the app takes deltas
+/// modulo 2^12, so driving forward and back across the counter's wrap many times loses nothing,
+/// and no wrap looks like a counter jump; a block carrying that width boots.
+static void twelve_bit_counters_wrap_both_ways_through_the_app(void)
+{
+    odo_params_t p;
+    odo_params_defaults(&p);
+    p.counter_bits = 12U;
+    p.truck[0].counts_per_rev_milli = p.truck[1].counts_per_rev_milli = 2000000U; /* 2000 counts/turn */
+    TEST_ASSERT_EQUAL(ODO_PARAMS_OK, odo_app_init_params(&app, &p));
+    int64_t c = 4096 - 300; /* just below the wrap */
+    uint8_t seq = 0U;
+    odo_tick_input_t in = tick(0U, ts_wrap_counter(c, 12U), ts_wrap_counter(c, 12U), seq);
+    odo_app_step(&app, &in, &out);
+    for (int k = 1; k <= 200; ++k) { /* forward 200 x 450 counts: 22 wraps */
+        c += 450;
+        ++seq;
+        in = tick(40000U * (uint64_t)k, ts_wrap_counter(c, 12U), ts_wrap_counter(c, 12U), seq);
+        odo_app_step(&app, &in, &out);
+        TEST_ASSERT_EQUAL_UINT32(0U, out.faults & (ODO_FAULT_COUNTER_JUMP_A | ODO_FAULT_COUNTER_JUMP_B));
+    }
+    /* 90000 counts of pi * 150 mm / 2000 */
+    TEST_ASSERT_DOUBLE_WITHIN(1e-3, 90000.0 * 3.14159265358979 * 150.0 / 2000.0,
+                              (double)app.truck[0].pose.x_mm_q32 / 4294967296.0);
+    for (int k = 201; k <= 400; ++k) { /* and back */
+        c -= 450;
+        ++seq;
+        in = tick(40000U * (uint64_t)k, ts_wrap_counter(c, 12U), ts_wrap_counter(c, 12U), seq);
+        odo_app_step(&app, &in, &out);
+        TEST_ASSERT_EQUAL_UINT32(0U, out.faults & (ODO_FAULT_COUNTER_JUMP_A | ODO_FAULT_COUNTER_JUMP_B));
+    }
+    TEST_ASSERT_INT64_WITHIN(4, 0, app.truck[0].pose.x_mm_q32);
+
+    uint8_t block[ODO_PARAMS_SIZE];
+    TEST_ASSERT_EQUAL(ODO_PARAMS_SIZE, odo_params_encode(&p, block, sizeof block));
+    TEST_ASSERT_EQUAL(ODO_PARAMS_OK, odo_app_init(&app, block, sizeof block));
+    TEST_ASSERT_EQUAL_UINT8(12U, app.params.counter_bits);
+}
+
 int main(void)
 {
     UNITY_BEGIN();
@@ -194,5 +233,6 @@ int main(void)
     RUN_TEST(missing_duplicated_and_lost_frames_are_flagged);
     RUN_TEST(impossible_jumps_decoder_errors_and_time_reversal_are_flagged);
     RUN_TEST(step_is_deterministic_for_identical_inputs);
+    RUN_TEST(twelve_bit_counters_wrap_both_ways_through_the_app);
     return UNITY_END();
 }

@@ -102,6 +102,74 @@ static void mul_s64_s32_shr_is_exact_through_96_bits(void)
 #endif
 }
 
+static void mul_s64_u32_shr_is_exact_through_96_bits(void)
+{
+    TEST_ASSERT_EQUAL_INT64(INT64_MIN, odo_mul_s64_u32_shr(INT64_MIN, 1U << 31, 31U));
+    TEST_ASSERT_EQUAL_INT64(-3, odo_mul_s64_u32_shr(-5, 1U, 1U)); /* -2.5 rounds away from zero */
+    TEST_ASSERT_EQUAL_INT64(3, odo_mul_s64_u32_shr(5, 1U, 1U));
+    TEST_ASSERT_EQUAL_INT64(INT64_MAX / 2 + 1, odo_mul_s64_u32_shr(INT64_MAX, 0x80000000U, 32U)); /* 2^62 - 0.5 */
+#ifdef __SIZEOF_INT128__
+    const int64_t ea[] = {INT64_MIN, INT64_MIN + 1, -1, 0, 1, INT64_MAX};
+    const uint32_t eb[] = {0U, 1U, 0x7FFFFFFFU, 0x80000000U, 0xFFFFFFFEU, UINT32_MAX};
+    for (int n = 0; n < 300000; ++n) {
+        const int64_t a = n < 36 ? ea[n / 6] : (int64_t)spread_u64();
+        const uint32_t b = n < 36 ? eb[n % 6] : (uint32_t)ts_rng_u64(&rng);
+        const unsigned shift = 1U + (unsigned)(ts_rng_u64(&rng) % 62U); /* 1..62 */
+        const __int128 p = (__int128)a * b;
+        const __int128 half = (__int128)1 << (shift - 1U);
+        const __int128 want = p >= 0 ? (p + half) >> shift : -((-p + half) >> shift);
+        if (want > INT64_MAX || want < INT64_MIN) {
+            continue; /* outside the documented domain */
+        }
+        TEST_ASSERT_EQUAL_INT64((int64_t)want, odo_mul_s64_u32_shr(a, b, shift));
+    }
+#endif
+}
+
+/// round(n 2^32 / d), computed here with a 64-bit division the firmware does not use.
+static uint32_t frac_reference(uint32_t n, uint32_t d)
+{
+    const uint64_t num = (uint64_t)n << 32;
+    const uint64_t q = num / d, r = num % d;
+    return (uint32_t)(q + (2U * r >= d ? 1U : 0U));
+}
+
+/// The fraction n/d in Q32 from two 32-bit divisions equals the 64-bit division's rounded result
+/// everywhere: every n < d for small d, both ends of every normalisation shift (d = 2^j and
+/// 2^(j+1) - 1), n = d - 1 (the largest result), and random pairs across all bit lengths; n >= d
+/// saturates.
+static void frac_q32_is_the_correctly_rounded_fraction(void)
+{
+    for (uint32_t d = 1U; d <= 300U; ++d) {
+        for (uint32_t n = 0U; n < d; ++n) {
+            TEST_ASSERT_EQUAL_HEX32(frac_reference(n, d), odo_frac_q32(n, d));
+        }
+    }
+    for (unsigned j = 0U; j < 32U; ++j) {
+        const uint32_t ds[2] = {1U << j, j == 31U ? UINT32_MAX : (2U << j) - 1U};
+        for (int k = 0; k < 2; ++k) {
+            const uint32_t d = ds[k];
+            const uint32_t ns[5] = {0U, d > 1U ? 1U : 0U, d / 2U, d > 1U ? d - 2U : 0U, d - 1U};
+            for (int i = 0; i < 5; ++i) {
+                TEST_ASSERT_EQUAL_HEX32(frac_reference(ns[i], d), odo_frac_q32(ns[i], d));
+            }
+        }
+    }
+    TEST_ASSERT_EQUAL_HEX32(0xFFFFFFFFU, odo_frac_q32(UINT32_MAX - 1U, UINT32_MAX));
+    TEST_ASSERT_EQUAL_HEX32(0x80000000U, odo_frac_q32(1U, 2U));
+    TEST_ASSERT_EQUAL_HEX32(0x55555555U, odo_frac_q32(1U, 3U));
+    TEST_ASSERT_EQUAL_HEX32(0xAAAAAAABU, odo_frac_q32(2U, 3U)); /* .666... rounds up */
+    for (int n = 0; n < 1000000; ++n) {
+        uint32_t d = (uint32_t)spread_u64();
+        d = d == 0U ? 1U : d;
+        const uint32_t nn = (uint32_t)(ts_rng_u64(&rng) % d);
+        TEST_ASSERT_EQUAL_HEX32(frac_reference(nn, d), odo_frac_q32(nn, d));
+    }
+    TEST_ASSERT_EQUAL_HEX32(UINT32_MAX, odo_frac_q32(5U, 5U));
+    TEST_ASSERT_EQUAL_HEX32(UINT32_MAX, odo_frac_q32(6U, 5U));
+    TEST_ASSERT_EQUAL_HEX32(UINT32_MAX, odo_frac_q32(0U, 0U));
+}
+
 static void shr_round_is_symmetric_and_safe_at_the_extremes(void)
 {
     TEST_ASSERT_EQUAL_INT64(2, odo_shr_round_s64(3, 1U));   /* 1.5 -> 2 */
@@ -119,5 +187,7 @@ int main(void)
     RUN_TEST(muldiv_rounds_to_nearest_and_reports_overflow);
     RUN_TEST(mul_s64_s32_shr_is_exact_through_96_bits);
     RUN_TEST(shr_round_is_symmetric_and_safe_at_the_extremes);
+    RUN_TEST(mul_s64_u32_shr_is_exact_through_96_bits);
+    RUN_TEST(frac_q32_is_the_correctly_rounded_fraction);
     return UNITY_END();
 }

@@ -2,6 +2,7 @@
 /// Doubles appear only as test references.
 #include <math.h>
 #include <stdint.h>
+#include <stdio.h>
 
 #include "odo/odo_odometry.h"
 #include "test_support.h"
@@ -225,6 +226,262 @@ static void parameters_that_cannot_be_represented_are_refused(void)
     TEST_ASSERT_EQUAL(ODO_MODEL_ERR_RANGE, odo_model_init(&m, &tp, 24U, 0U, 40000U, 3000U));
 }
 
+/* ---------------------------------------------------------------------------------------------
+ * Tyre scrub (odo_odometry.h): dtheta = dtheta(Eq. 2.4) * (1 - k m / v).
+ * ------------------------------------------------------------------------------------------- */
+
+/// Run the same count stream through two models and return both trucks.
+static void drive_pair(const odo_model_t *a, const odo_model_t *b, const int32_t (*d)[2], int n, uint8_t bits,
+                       odo_truck_t *ta, odo_truck_t *tb)
+{
+    *ta = truck_at_origin(a, 0U, 0U, bits);
+    *tb = truck_at_origin(b, 0U, 0U, bits);
+    int64_t c[2] = {0, 0};
+    odo_step_t st;
+    for (int i = 0; i < n; ++i) {
+        c[0] += d[i][0];
+        c[1] += d[i][1];
+        odo_truck_step(ta, a, ts_wrap_counter(c[0], bits), ts_wrap_counter(c[1], bits), bits, &st);
+        TEST_ASSERT_FALSE(st.jump);
+        odo_truck_step(tb, b, ts_wrap_counter(c[0], bits), ts_wrap_counter(c[1], bits), bits, &st);
+        TEST_ASSERT_FALSE(st.jump);
+    }
+}
+
+/// 000 Eq. 2.4 / Eq. 2.8, extended: on a spot turn (wheels opposite, s = 1) or a pivot on one wheel
+/// m = 0, so Eb alone is the wheelbase there (what UMBmark measures) and k changes nothing, bit for
+/// bit.
+static void spot_turn_is_unchanged_by_scrub(void)
+{
+    odo_truck_params_t tp = labmate(), tk = labmate();
+    tp.eb_q30 = tk.eb_q30 = Q30(1.0065);
+    static const int32_t ks_q30[] = {Q30(0.2), Q30(-0.2), Q30(0.0095), (int32_t)(1 << 28), -(int32_t)(1 << 28)};
+    int32_t d[300][2];
+    for (int i = 0; i < 300; ++i) {
+        const int32_t n = 1 + (i * 37) % 600;
+        d[i][0] = (i % 3 == 2) ? 0 : ((i & 1) ? -n : n);     /* spot turns both ways, pivots */
+        d[i][1] = (i % 3 == 2) ? n : -d[i][0];
+    }
+    for (size_t k = 0; k < sizeof ks_q30 / sizeof ks_q30[0]; ++k) {
+        tk.scrub_q30 = ks_q30[k];
+        const odo_model_t m0 = model_of(&tp, 24U, ODO_HEADING_MIDPOINT), mk = model_of(&tk, 24U, ODO_HEADING_MIDPOINT);
+        odo_truck_t a, b;
+        drive_pair(&m0, &mk, (const int32_t(*)[2])d, 300, 24U, &a, &b);
+        TEST_ASSERT_EQUAL_UINT64(a.pose.heading_q64, b.pose.heading_q64);
+        TEST_ASSERT_EQUAL_INT64(a.pose.x_mm_q32, b.pose.x_mm_q32);
+        TEST_ASSERT_EQUAL_INT64(a.pose.y_mm_q32, b.pose.y_mm_q32);
+    }
+    /* a spot turn's heading is Eq. 2.4 over b Eb, computed here in double */
+    tk.scrub_q30 = Q30(0.2);
+    const odo_model_t mk = model_of(&tk, 24U, ODO_HEADING_MIDPOINT);
+    odo_truck_t t = truck_at_origin(&mk, 0U, 0U, 24U);
+    odo_step_t st;
+    odo_truck_step(&t, &mk, ts_wrap_counter(-500, 24U), 500U, 24U, &st);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-12, 1000.0 * cm_mm(&tk) / (340.0 * (tk.eb_q30 / 1073741824.0)),
+                              TURNS_Q64_TO_RAD(t.pose.heading_q64));
+}
+
+/// An arc of radius R (same-sign wheels, s = b / 2R) turns by Eq. 2.4's angle times
+/// 1 - k m / v, m = 2 min(|dL|, |dR|), v = |dL| + |dR|, computed here from the integer counts; the
+/// distance is unchanged. Forward and backward, left and right, k of either sign; and the
+/// effective wheelbase is b Eb / (1 - k (1 - s)).
+static void arc_of_known_radius_gets_the_predicted_factor(void)
+{
+    static const struct {
+        int32_t dl, dr;
+        double k;
+    } arcs[] = {
+        {1000, 1459, 0.0095},  /* R ~ 0.43 m at b 340 mm, OptiOdom's k */
+        {1459, 1000, 0.0095},  /* the other side */
+        {-1000, -1459, 0.0095}, /* backwards */
+        {700, 2100, 0.2},      /* tight: s = 0.5 */
+        {2100, 700, -0.2},
+        {1500, 1501, -0.25},   /* almost straight: s ~ 3e-4 */
+        {1, 600, 0.25},        /* almost a pivot */
+    };
+    for (size_t i = 0; i < sizeof arcs / sizeof arcs[0]; ++i) {
+        odo_truck_params_t tp = labmate(), tk = labmate();
+        tp.eb_q30 = tk.eb_q30 = Q30(1.0065);
+        tk.scrub_q30 = Q30(arcs[i].k);
+        const odo_model_t m0 = model_of(&tp, 32U, ODO_HEADING_MIDPOINT), mk = model_of(&tk, 32U, ODO_HEADING_MIDPOINT);
+        odo_step_t s0, sk;
+        odo_truck_t a = truck_at_origin(&m0, 0U, 0U, 32U), b = truck_at_origin(&mk, 0U, 0U, 32U);
+        odo_truck_step(&a, &m0, (uint32_t)arcs[i].dl, (uint32_t)arcs[i].dr, 32U, &s0);
+        odo_truck_step(&b, &mk, (uint32_t)arcs[i].dl, (uint32_t)arcs[i].dr, 32U, &sk);
+        const double al = fabs((double)arcs[i].dl), ar = fabs((double)arcs[i].dr);
+        const double g = 1.0 - (tk.scrub_q30 / 1073741824.0) * 2.0 * fmin(al, ar) / (al + ar);
+        char msg[64];
+        snprintf(msg, sizeof msg, "arc %u", (unsigned)i);
+        /* the factor, on the firmware's own Eq. 2.4 angle: within 2^-33 relative (m / v in Q32)
+         * plus half an LSB per count (k times the per-count multipliers, rounded) */
+        TEST_ASSERT_DOUBLE_WITHIN_MESSAGE(fabs(g * (double)s0.dturn_q64) * 2e-10 + (al + ar), g * (double)s0.dturn_q64,
+                                          (double)sk.dturn_q64, msg);
+        TEST_ASSERT_EQUAL_INT64_MESSAGE(s0.dist_mm_q40, sk.dist_mm_q40, msg);
+        /* against the effective wheelbase of the header, in double from the parameters */
+        const double s = fabs(ar - al) / (al + ar);
+        const double b_arc = 340.0 * (tk.eb_q30 / 1073741824.0) / (1.0 - (tk.scrub_q30 / 1073741824.0) * (1.0 - s));
+        const double want = (arcs[i].dr - arcs[i].dl) * cm_mm(&tk) / b_arc;
+        TEST_ASSERT_DOUBLE_WITHIN_MESSAGE(fabs(want) * 5e-11 + 1e-15, want, TURNS_Q64_TO_RAD(b.pose.heading_q64), msg);
+    }
+    /* equal wheels with Ed != 1 (m / v = 1): the factor is exactly 1 - k */
+    odo_truck_params_t tp = labmate(), tk = labmate();
+    tp.ed_q30 = tk.ed_q30 = Q30(1.01);
+    tk.scrub_q30 = Q30(0.125);
+    const odo_model_t m0 = model_of(&tp, 24U, ODO_HEADING_MIDPOINT), mk = model_of(&tk, 24U, ODO_HEADING_MIDPOINT);
+    odo_truck_t a = truck_at_origin(&m0, 0U, 0U, 24U), b = truck_at_origin(&mk, 0U, 0U, 24U);
+    odo_step_t s0, sk;
+    odo_truck_step(&a, &m0, 1000U, 1000U, 24U, &s0);
+    odo_truck_step(&b, &mk, 1000U, 1000U, 24U, &sk);
+    TEST_ASSERT_TRUE(s0.dturn_q64 > 0);
+    /* k dtheta comes from k-scaled per-count multipliers, each rounded to half a Q64 LSB: 2000
+     * counts give at most 1000 LSB (5e-17 rad) */
+    TEST_ASSERT_INT64_WITHIN(1000, s0.dturn_q64 - s0.dturn_q64 / 8, sk.dturn_q64);
+}
+
+/// k == 0 is the firmware before the term, bit for bit: the heading change is exactly Eq. 2.4's
+/// modular sum of the model's own multipliers, on every kind of tick, including arcs.
+static void zero_scrub_is_bit_identical_to_plain_eq_2_4(void)
+{
+    ts_rng_t rng;
+    ts_rng_seed(&rng, 0x5C4ABULL);
+    odo_truck_params_t tp = labmate();
+    tp.ed_q30 = Q30(1.0031);
+    tp.eb_q30 = Q30(0.9917);
+    tp.scrub_q30 = 0;
+    const odo_model_t m = model_of(&tp, 24U, ODO_HEADING_MIDPOINT);
+    odo_truck_t t = truck_at_origin(&m, 0U, 0U, 24U);
+    int64_t c[2] = {0, 0};
+    for (int i = 0; i < 20000; ++i) {
+        int32_t d[2];
+        for (int w = 0; w < 2; ++w) {
+            d[w] = (int32_t)ts_rng_range(&rng, -(int64_t)m.max_counts, (int64_t)m.max_counts);
+            c[w] += d[w];
+        }
+        odo_pose_t before = t.pose;
+        odo_step_t st;
+        odo_truck_step(&t, &m, ts_wrap_counter(c[0], 24U), ts_wrap_counter(c[1], 24U), 24U, &st);
+        const uint64_t want = m.turn_q64[1] * (uint64_t)(int64_t)d[1] - m.turn_q64[0] * (uint64_t)(int64_t)d[0];
+        TEST_ASSERT_EQUAL_UINT64(want, (uint64_t)st.dturn_q64);
+        TEST_ASSERT_EQUAL_UINT64(before.heading_q64 + want, t.pose.heading_q64);
+    }
+}
+
+/// The firmware's scrub term against the double reference's formula over many random ticks: the
+/// relative error of the factor stays below 2^-32 (m / v in Q32, then k dtheta).
+static void scrub_factor_error_is_below_2e_minus_32_on_random_ticks(void)
+{
+    ts_rng_t rng;
+    ts_rng_seed(&rng, 0xFAC7ULL);
+    odo_truck_params_t tp = labmate(), tk = labmate();
+    tk.scrub_q30 = -(int32_t)(1 << 28); /* the largest |k| */
+    tp.counts_per_rev_milli = tk.counts_per_rev_milli = 4000000000U; /* big deltas: up to ~1e6 */
+    const odo_model_t m0 = model_of(&tp, 32U, ODO_HEADING_MIDPOINT), mk = model_of(&tk, 32U, ODO_HEADING_MIDPOINT);
+    double worst = 0.0;
+    for (int i = 0; i < 100000; ++i) {
+        const int32_t sign = (i & 1) ? 1 : -1;
+        const int32_t dl = sign * (int32_t)ts_rng_range(&rng, 1, (int64_t)m0.max_counts);
+        const int32_t dr = sign * (int32_t)ts_rng_range(&rng, 1, (int64_t)m0.max_counts);
+        odo_truck_t a = truck_at_origin(&m0, 0U, 0U, 32U), b = truck_at_origin(&mk, 0U, 0U, 32U);
+        odo_step_t s0, sk;
+        odo_truck_step(&a, &m0, (uint32_t)dl, (uint32_t)dr, 32U, &s0);
+        odo_truck_step(&b, &mk, (uint32_t)dl, (uint32_t)dr, 32U, &sk);
+        if (s0.dturn_q64 == 0) {
+            continue;
+        }
+        const long double al = fabsl((long double)dl), ar = fabsl((long double)dr);
+        const long double g = 1.0L + 0.25L * 2.0L * fminl(al, ar) / (al + ar);
+        const long double want = g * (long double)s0.dturn_q64;
+        const double err = (double)(fabsl((long double)sk.dturn_q64 - want) / fabsl(want));
+        worst = fmax(worst, err);
+    }
+    TEST_ASSERT_TRUE_MESSAGE(worst < ldexp(1.0, -32), "relative error of the scrub factor");
+}
+
+/* ---------------------------------------------------------------------------------------------
+ * Counter widths 8..32 (odo_params_t.counter_bits).
+ * ------------------------------------------------------------------------------------------- */
+
+/// Every (prev, cur) pair of an 8-bit counter, and random ones of 12 and the other widths: the
+/// delta is the shortest way round, so wraps both ways are exact.
+static void count_delta_handles_8_and_12_bit_counters(void)
+{
+    for (uint32_t prev = 0; prev < 256U; ++prev) {
+        for (uint32_t cur = 0; cur < 256U; ++cur) {
+            int32_t want = (int32_t)((cur - prev) & 0xFFU);
+            if (want >= 128) {
+                want -= 256;
+            }
+            TEST_ASSERT_EQUAL_INT32(want, odo_count_delta(prev, cur, 8U));
+        }
+    }
+    TEST_ASSERT_EQUAL_INT32(3, odo_count_delta(0xFFEU, 0x001U, 12U));
+    TEST_ASSERT_EQUAL_INT32(-3, odo_count_delta(0x001U, 0xFFEU, 12U));
+    TEST_ASSERT_EQUAL_INT32(-2048, odo_count_delta(0U, 0x800U, 12U));
+    TEST_ASSERT_EQUAL_INT32(2047, odo_count_delta(0U, 0x7FFU, 12U));
+    ts_rng_t rng;
+    ts_rng_seed(&rng, 12U);
+    for (int n = 0; n < 100000; ++n) {
+        const uint8_t bits = (uint8_t)ts_rng_range(&rng, 8, 32);
+        const int64_t half = (int64_t)1 << (bits - 1U);
+        const int64_t start = ts_rng_range(&rng, 0, 2 * half - 1);
+        const int64_t delta = ts_rng_range(&rng, -half, half - 1);
+        TEST_ASSERT_EQUAL_INT32((int32_t)delta, odo_count_delta(ts_wrap_counter(start, bits),
+                                                                ts_wrap_counter(start + delta, bits), bits));
+    }
+}
+
+/// A robot with 8- or 12-bit decoders drives forward and then back across many counter wraps:
+/// the distance is the counts times cm, and it comes back to the origin exactly.
+static void narrow_counters_wrap_both_ways_without_losing_counts(void)
+{
+    static const struct {
+        uint8_t bits;
+        uint32_t counts_milli; /* coarse enough that 3 m/s stays below half the counter range */
+        int32_t per_tick;
+    } cases[] = {{8U, 100000U, 25}, {12U, 2000000U, 500}, {12U, 2000000U, 17}, {9U, 200000U, 50}};
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
+        odo_truck_params_t tp = labmate();
+        tp.counts_per_rev_milli = cases[i].counts_milli;
+        const uint8_t bits = cases[i].bits;
+        const odo_model_t m = model_of(&tp, bits, ODO_HEADING_MIDPOINT);
+        TEST_ASSERT_TRUE(m.max_counts < (1U << (bits - 1U)));
+        const uint32_t start = (1U << bits) - 7U; /* just below the wrap */
+        odo_truck_t t = truck_at_origin(&m, start, start, bits);
+        odo_step_t st;
+        int64_t c = start;
+        int wraps = 0;
+        for (int k = 0; k < 400; ++k) { /* forward: up through the wrap, many times */
+            c += cases[i].per_tick;
+            odo_truck_step(&t, &m, ts_wrap_counter(c, bits), ts_wrap_counter(c, bits), bits, &st);
+            TEST_ASSERT_FALSE(st.jump);
+            TEST_ASSERT_EQUAL_INT32(cases[i].per_tick, st.delta[0]);
+            wraps += (ts_wrap_counter(c, bits) < ts_wrap_counter(c - cases[i].per_tick, bits)) ? 1 : 0;
+        }
+        TEST_ASSERT_TRUE(wraps >= 2);
+        TEST_ASSERT_DOUBLE_WITHIN(1e-6, 400.0 * cases[i].per_tick * cm_mm(&tp), MM_Q32(t.pose.x_mm_q32));
+        for (int k = 0; k < 400; ++k) { /* and back down through it */
+            c -= cases[i].per_tick;
+            odo_truck_step(&t, &m, ts_wrap_counter(c, bits), ts_wrap_counter(c, bits), bits, &st);
+            TEST_ASSERT_FALSE(st.jump);
+            TEST_ASSERT_EQUAL_INT32(-cases[i].per_tick, st.delta[1]);
+        }
+        TEST_ASSERT_INT64_WITHIN(2, 0, t.pose.x_mm_q32);
+        TEST_ASSERT_EQUAL_UINT64(0U, t.pose.heading_q64);
+    }
+    /* model widths: 8..32 only */
+    odo_truck_params_t tp = labmate();
+    tp.counts_per_rev_milli = 100000U;
+    odo_model_t m;
+    TEST_ASSERT_EQUAL(ODO_MODEL_ERR_RANGE, odo_model_init(&m, &tp, 7U, 0U, 40000U, 3000U));
+    TEST_ASSERT_EQUAL(ODO_MODEL_OK, odo_model_init(&m, &tp, 8U, 0U, 40000U, 3000U));
+    TEST_ASSERT_EQUAL(ODO_MODEL_ERR_RANGE, odo_model_init(&m, &tp, 33U, 0U, 40000U, 3000U));
+    /* the default 39000-count labmate moves ~9900 counts per tick at 3 m/s: too many for 12 bits */
+    tp = labmate();
+    TEST_ASSERT_EQUAL(ODO_MODEL_ERR_RANGE, odo_model_init(&m, &tp, 12U, 0U, 40000U, 3000U));
+    tp.scrub_q30 = (int32_t)(1 << 28) + 1; /* |k| > 1/4 */
+    TEST_ASSERT_EQUAL(ODO_MODEL_ERR_RANGE, odo_model_init(&m, &tp, 24U, 0U, 40000U, 3000U));
+}
+
 int main(void)
 {
     UNITY_BEGIN();
@@ -237,5 +494,11 @@ int main(void)
     RUN_TEST(implausible_counter_jump_is_flagged_not_integrated);
     RUN_TEST(inverted_encoders_count_forward);
     RUN_TEST(parameters_that_cannot_be_represented_are_refused);
+    RUN_TEST(spot_turn_is_unchanged_by_scrub);
+    RUN_TEST(arc_of_known_radius_gets_the_predicted_factor);
+    RUN_TEST(zero_scrub_is_bit_identical_to_plain_eq_2_4);
+    RUN_TEST(scrub_factor_error_is_below_2e_minus_32_on_random_ticks);
+    RUN_TEST(count_delta_handles_8_and_12_bit_counters);
+    RUN_TEST(narrow_counters_wrap_both_ways_without_losing_counts);
     return UNITY_END();
 }

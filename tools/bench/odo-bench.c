@@ -32,10 +32,14 @@ static void usage(FILE *f)
             "Prints the firmware's benchmark figures:\n"
             "  pos_err_mm_1km, heading_err_rad_1km  fixed point vs double after 1 km of mixed\n"
             "                                       driving (worst of 6 runs; targets 0.1, 1e-6)\n"
+            "  pos_err_mm_1km_scrub, heading_err_rad_1km_scrub  the same with the tyre-scrub\n"
+            "                                       term on, k = +-0.01 and +-0.2 (worst of 8 runs)\n"
             "  sincos_max_abs_err, atan2_max_abs_err_rad  vs libm over 10^6 random inputs + edges\n"
             "  ipec_step_instructions               the same with IPEC on (paper form, every tick)\n"
             "  step_instructions                    x86-64 instructions per 40 ms application\n"
             "                                       step for two trucks, counted by callgrind\n"
+            "  scrub_step_instructions              the same with scrub k = 0.0095 on both trucks\n"
+            "  scrub_arc_step_instructions          the same on arcs only (the term's worst case)\n"
             "  sim_umbmark_10runs_s                 wall seconds for the 10-run UMBmark set of the\n"
             "                                       000 s. 4.6.2 robot at 1 ms physics, firmware in\n"
             "                                       the loop (target < 1 s on one core)\n"
@@ -48,21 +52,31 @@ static void usage(FILE *f)
             "  --quick  fewer samples (for smoke tests; figures are then indicative only)\n");
 }
 
+typedef enum { KERNEL_PLAIN, KERNEL_IPEC, KERNEL_SCRUB, KERNEL_SCRUB_ARC } kernel_t;
+
 /// Hidden mode run under callgrind: KERNEL_STEPS application steps of a clapper (two trucks).
-static int run_kernel(int ipec)
+static int run_kernel(kernel_t kind)
 {
     static odo_app_t app;
     static odo_tick_output_t out;
+    const int ipec = kind == KERNEL_IPEC;
     odo_params_t p;
     odo_params_defaults(&p);
     p.vehicle = ODO_VEHICLE_CLAPPER;
     p.ipec_mode = (uint8_t)(ipec ? ODO_IPEC_PAPER : ODO_IPEC_OFF); /* --kernel-ipec: 002 Eqs. 9-16 */
+    if (kind == KERNEL_SCRUB || kind == KERNEL_SCRUB_ARC) { /* the OptiOdom robot's k */
+        p.truck[0].scrub_q30 = p.truck[1].scrub_q30 = (int32_t)llround(0.0095 * 1073741824.0);
+    }
     if (odo_app_init_params(&app, &p) != ODO_PARAMS_OK) {
         return 2;
     }
     odo_synth_t s[2];
     odo_synth_init(&s[0], 1U, &p.truck[0], p.tick_us);
     odo_synth_init(&s[1], 2U, &p.truck[1], p.tick_us);
+    if (kind == KERNEL_SCRUB_ARC) { /* both wheels forward at different speeds on every tick */
+        odo_synth_segment(&s[0], 400.0, 700.0, KERNEL_STEPS + 1U);
+        odo_synth_segment(&s[1], 900.0, 650.0, KERNEL_STEPS + 1U);
+    }
     int64_t c[2][2] = {{0, 0}, {0, 0}};
     uint64_t sink = 0U;
     for (uint32_t i = 0U; i < KERNEL_STEPS; ++i) {
@@ -188,9 +202,13 @@ int main(int argc, char **argv)
     int json = 0, quick = 0;
     for (int i = 1; i < argc; ++i) {
         if (strcmp(argv[i], "--kernel") == 0) {
-            return run_kernel(0);
+            return run_kernel(KERNEL_PLAIN);
         } else if (strcmp(argv[i], "--kernel-ipec") == 0) {
-            return run_kernel(1);
+            return run_kernel(KERNEL_IPEC);
+        } else if (strcmp(argv[i], "--kernel-scrub") == 0) {
+            return run_kernel(KERNEL_SCRUB);
+        } else if (strcmp(argv[i], "--kernel-scrub-arc") == 0) {
+            return run_kernel(KERNEL_SCRUB_ARC);
         } else if (strcmp(argv[i], "--json") == 0) {
             json = 1;
         } else if (strcmp(argv[i], "--quick") == 0) {
@@ -220,6 +238,20 @@ int main(int argc, char **argv)
         pos = fmax(pos, r.pos_err_mm);
         head = fmax(head, r.heading_err_rad);
     }
+    fprintf(stderr, "odo-bench: the same with the tyre-scrub term, k = +-0.01 and +-0.2 ...\n");
+    double pos_scrub = 0.0, head_scrub = 0.0;
+    static const double scrub_k[4] = {0.01, -0.01, 0.2, -0.2};
+    for (int run = 0; run < (quick ? 4 : 8); ++run) {
+        odo_truck_params_t tp = p.truck[0];
+        tp.scrub_q30 = (int32_t)llround(scrub_k[run % 4] * 1073741824.0);
+        odo_refcheck_t r;
+        if (odo_refcheck_run(2000U + (uint64_t)run, widths[run % 3], (uint8_t)(run / 4), &tp, &tp, 1.0e6, &r) != 0) {
+            fprintf(stderr, "odo-bench: scrub parameters refused by the model\n");
+            return 1;
+        }
+        pos_scrub = fmax(pos_scrub, r.pos_err_mm);
+        head_scrub = fmax(head_scrub, r.heading_err_rad);
+    }
     fprintf(stderr, "odo-bench: trig accuracy against libm ...\n");
     double sc = 0.0, at = 0.0;
     odo_trig_accuracy(42U, quick ? 100000U : 1000000U, &sc, &at);
@@ -227,6 +259,8 @@ int main(int argc, char **argv)
     char tool[160] = "";
     const double instr = step_instructions(tool, sizeof tool, "--kernel");
     const double ipec_instr = instr >= 0.0 ? step_instructions(tool, sizeof tool, "--kernel-ipec") : -1.0;
+    const double scrub_instr = instr >= 0.0 ? step_instructions(tool, sizeof tool, "--kernel-scrub") : -1.0;
+    const double scrub_arc_instr = instr >= 0.0 ? step_instructions(tool, sizeof tool, "--kernel-scrub-arc") : -1.0;
     fprintf(stderr, "odo-bench: 10-run UMBmark in the simulator ...\n");
     double sim_s = 0.0;
     const double sim_wall = sim_umbmark_10runs(&sim_s);
@@ -236,8 +270,9 @@ int main(int argc, char **argv)
 
     if (json) {
         printf("{\"pos_err_mm_1km\": %.6g, \"heading_err_rad_1km\": %.6g, "
+               "\"pos_err_mm_1km_scrub\": %.6g, \"heading_err_rad_1km_scrub\": %.6g, "
                "\"sincos_max_abs_err\": %.6g, \"atan2_max_abs_err_rad\": %.6g, ",
-               pos, head, sc, at);
+               pos, head, pos_scrub, head_scrub, sc, at);
         if (instr >= 0.0) {
             printf("\"step_instructions\": %.0f, \"step_instructions_tool\": \"%s\", ", instr, tool);
         } else {
@@ -248,6 +283,12 @@ int main(int argc, char **argv)
             printf("\"ipec_step_instructions\": %.0f, ", ipec_instr); /* two trucks + IPEC (paper form) */
         } else {
             printf("\"ipec_step_instructions\": null, ");
+        }
+        if (scrub_instr >= 0.0 && scrub_arc_instr >= 0.0) { /* two trucks, scrub term on (k 0.0095) */
+            printf("\"scrub_step_instructions\": %.0f, \"scrub_arc_step_instructions\": %.0f, ", scrub_instr,
+                   scrub_arc_instr);
+        } else {
+            printf("\"scrub_step_instructions\": null, \"scrub_arc_step_instructions\": null, ");
         }
         if (sim_wall >= 0.0) {
             printf("\"sim_umbmark_10runs_s\": %.4f, \"sim_realtime_factor\": %.0f, \"sim_seconds\": %.1f, ",
@@ -270,16 +311,19 @@ int main(int argc, char **argv)
             printf("\"replay_ticks_per_s\": null, \"replay_vs_python_can_ratio\": null, ");
         }
         printf("\"targets\": {\"pos_err_mm_1km\": 0.1, "
-               "\"heading_err_rad_1km\": 1e-06, \"sincos_max_abs_err\": 2e-08, "
+               "\"heading_err_rad_1km\": 1e-06, \"pos_err_mm_1km_scrub\": 0.1, "
+               "\"heading_err_rad_1km_scrub\": 1e-06, \"sincos_max_abs_err\": 2e-08, "
                "\"atan2_max_abs_err_rad\": 1e-07, \"sim_umbmark_10runs_s\": 1.0, "
                "\"replay_vs_python_can_ratio\": 20}}\n");
     } else {
         printf("fixed vs double, 1 km     position %.3g mm (target <= 0.1)  heading %.3g rad (<= 1e-6)\n",
                pos, head);
+        printf("  with scrub k +-0.01/0.2 position %.3g mm  heading %.3g rad\n", pos_scrub, head_scrub);
         printf("sin/cos max abs error     %.3g (target <= 2e-8)\n", sc);
         printf("atan2 max abs error       %.3g rad (target <= 1e-7)\n", at);
         if (instr >= 0.0) {
             printf("application step          %.0f instructions (2 trucks; %s)\n", instr, tool);
+            printf("  with scrub k 0.0095     %.0f (mixed driving), %.0f (arcs only)\n", scrub_instr, scrub_arc_instr);
         } else {
             printf("application step          not measured (valgrind not available)\n");
         }
@@ -296,6 +340,6 @@ int main(int argc, char **argv)
             printf("\n");
         }
     }
-    const int ok = pos <= 0.1 && head <= 1e-6 && sc <= 2e-8 && at <= 1e-7;
+    const int ok = pos <= 0.1 && head <= 1e-6 && pos_scrub <= 0.1 && head_scrub <= 1e-6 && sc <= 2e-8 && at <= 1e-7;
     return ok ? 0 : 1;
 }

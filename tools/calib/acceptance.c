@@ -98,6 +98,7 @@ static void with_calibration(const sim_robot_t *base, const odo_params_t *p, sim
     out->truck[0].cal_ed = p->truck[0].ed_q30 / Q30;
     out->truck[0].cal_eb = p->truck[0].eb_q30 / Q30;
     out->truck[0].cal_es = p->truck[0].es_q30 / Q30;
+    out->truck[0].cal_scrub = p->truck[0].scrub_q30 / Q30;
     out->truck[0].has_calibration = true;
 }
 

@@ -30,12 +30,42 @@ static uint64_t rd_le(const uint8_t *b, unsigned n)
     return v;
 }
 
+/// "versions 1 (128 bytes) and 2 (256 bytes)": what this tool reads, for messages.
+static const char *known_layouts(void) { return "versions 1 (128 bytes) and 2 (256 bytes)"; }
+
+typedef enum { CAND_TRUNCATED, CAND_GOOD, CAND_BAD_CRC, CAND_OTHER_LAYOUT, CAND_NOISE } cand_t;
+
+/// Classify an 'ODOP' at b with `avail` readable bytes: a block of a version this tool reads
+/// (good, or with a bad CRC), cut off before its declared size, a block of another layout (its
+/// declared length holds a good CRC-32 in its last 4 bytes), or just the magic in code/data.
+static cand_t classify(const uint8_t *b, size_t avail)
+{
+    if (avail < ODO_PARAMS_HEADER_SIZE) {
+        return CAND_TRUNCATED;
+    }
+    const size_t len = (size_t)rd_le(b + 6, 2);
+    const size_t size = odo_params_version_size((uint16_t)rd_le(b + 4, 2));
+    if (size != 0U && len == size) {
+        if (avail < size) {
+            return CAND_TRUNCATED;
+        }
+        odo_params_t p;
+        const odo_params_status_t st = odo_params_parse(b, size, &p);
+        return (st == ODO_PARAMS_OK || st == ODO_PARAMS_ERR_RANGE) ? CAND_GOOD : CAND_BAD_CRC;
+    }
+    if (len >= ODO_PARAMS_HEADER_SIZE + 4U && len <= avail &&
+        odo_crc32(b, len - 4U) == (uint32_t)rd_le(b + len - 4U, 4)) {
+        return CAND_OTHER_LAYOUT;
+    }
+    return CAND_NOISE;
+}
+
 /// Find the one good block among the magic's occurrences in buf (valid: NULL or a per-byte mask).
 /// Returns 0 with *off, or -1 with a message naming offsets as base + offset.
 static int locate(const uint8_t *buf, size_t len, const uint8_t *valid, uint64_t base, const char *what,
                   size_t *off, char *err, size_t errlen)
 {
-    size_t n_cand = 0, n_good = 0, good = 0, crc_ok = 0, n_crc_ok = 0, first = 0;
+    size_t n_cand = 0, n_good = 0, good = 0, n_other = 0, other = 0, n_bad_crc = 0, bad_crc = 0;
     int truncated = 0;
     size_t trunc_at = 0;
     for (size_t i = 0; i + 4 <= len; ++i) {
@@ -45,33 +75,37 @@ static int locate(const uint8_t *buf, size_t len, const uint8_t *valid, uint64_t
         if (valid != NULL && !(valid[i] && valid[i + 1] && valid[i + 2] && valid[i + 3])) {
             continue;
         }
-        if (n_cand++ == 0) {
-            first = i;
-        }
+        n_cand++;
         size_t avail = len - i;
         if (valid != NULL) {
             size_t k = 0;
-            while (k < avail && k < ODO_PARAMS_SIZE && valid[i + k]) {
+            while (k < avail && k <= 0xFFFFU && valid[i + k]) {
                 k++;
             }
             avail = k;
         }
-        if (avail < ODO_PARAMS_SIZE) {
-            truncated = 1;
-            trunc_at = i;
-            continue;
-        }
-        odo_params_t p;
-        const odo_params_status_t st = odo_params_parse(buf + i, ODO_PARAMS_SIZE, &p);
-        if (st == ODO_PARAMS_OK || st == ODO_PARAMS_ERR_RANGE) {
+        switch (classify(buf + i, avail)) {
+        case CAND_GOOD:
             if (n_good++ == 0) {
                 good = i;
             }
-        }
-        if (odo_crc32(buf + i, ODO_PARAMS_CRC_OFFSET) == (uint32_t)rd_le(buf + i + ODO_PARAMS_CRC_OFFSET, 4)) {
-            if (n_crc_ok++ == 0) {
-                crc_ok = i;
+            break;
+        case CAND_BAD_CRC:
+            if (n_bad_crc++ == 0) {
+                bad_crc = i;
             }
+            break;
+        case CAND_OTHER_LAYOUT:
+            if (n_other++ == 0) {
+                other = i;
+            }
+            break;
+        case CAND_TRUNCATED:
+            truncated = 1;
+            trunc_at = i;
+            break;
+        case CAND_NOISE:
+            break;
         }
     }
     if (n_good == 1) {
@@ -82,38 +116,22 @@ static int locate(const uint8_t *buf, size_t len, const uint8_t *valid, uint64_t
         snprintf(err, errlen, "%s: %zu valid parameter blocks found: ambiguous, refusing to choose", what, n_good);
         return -1;
     }
-    if (n_crc_ok > 0) {
+    if (n_other > 0) {
         /* A block with a good CRC whose header this tool does not accept: another layout. */
-        const uint8_t *b = buf + crc_ok;
+        const uint8_t *b = buf + other;
         snprintf(err, errlen, "%s: parameter block at 0x%llx has layout version %u, length %u; this tool "
-                              "knows version %u, length %u: refusing to touch it", what,
-                 (unsigned long long)(base + crc_ok), (unsigned)rd_le(b + 4, 2), (unsigned)rd_le(b + 6, 2),
-                 ODO_PARAMS_VERSION, ODO_PARAMS_SIZE);
+                              "reads %s: refusing to touch it", what, (unsigned long long)(base + other),
+                 (unsigned)rd_le(b + 4, 2), (unsigned)rd_le(b + 6, 2), known_layouts());
         return -1;
     }
     if (truncated) {
         snprintf(err, errlen, "%s: truncated: the parameter block starting at 0x%llx is cut off before its "
-                              "%u bytes", what, (unsigned long long)(base + trunc_at), ODO_PARAMS_SIZE);
+                              "declared length", what, (unsigned long long)(base + trunc_at));
         return -1;
     }
-    if (n_cand == 1) {
-        /* One candidate with a bad CRC: report why it does not parse. */
-        odo_params_t p;
-        const odo_params_status_t st = odo_params_parse(buf + first, ODO_PARAMS_SIZE, &p);
-        const uint8_t *b = buf + first;
-        if (st == ODO_PARAMS_ERR_CRC) {
-            *off = first; /* the only block there is, damaged: the caller decides (write --force) */
-            return 0;
-        }
-        if (st == ODO_PARAMS_ERR_VERSION || st == ODO_PARAMS_ERR_LENGTH) {
-            snprintf(err, errlen, "%s: parameter block at 0x%llx has layout version %u, length %u; this tool "
-                                  "knows version %u, length %u", what, (unsigned long long)(base + first),
-                     (unsigned)rd_le(b + 4, 2), (unsigned)rd_le(b + 6, 2), ODO_PARAMS_VERSION, ODO_PARAMS_SIZE);
-        } else {
-            snprintf(err, errlen, "%s: parameter block at 0x%llx: %s", what, (unsigned long long)(base + first),
-                     odo_params_status_str(st));
-        }
-        return -1;
+    if (n_bad_crc == 1) {
+        *off = bad_crc; /* the only block there is, damaged: the caller decides (write --force) */
+        return 0;
     }
     snprintf(err, errlen, "%s: no parameter block found (%zu 'ODOP' candidates, none with a valid header and "
                           "CRC-32)", what, n_cand);
@@ -172,12 +190,12 @@ static int load_elf(img_t *img, const char *path, char *err, size_t errlen)
             snprintf(err, errlen, "%s: section .odo_params has no file content (NOBITS)", path);
             return -1;
         }
-        if (size < ODO_PARAMS_SIZE) {
-            snprintf(err, errlen, "%s: section .odo_params is %llu bytes, a version-%u block needs %u", path,
-                     (unsigned long long)size, ODO_PARAMS_VERSION, ODO_PARAMS_SIZE);
+        if (size < ODO_PARAMS_HEADER_SIZE) {
+            snprintf(err, errlen, "%s: section .odo_params is %llu bytes, too small for a parameter block", path,
+                     (unsigned long long)size);
             return -1;
         }
-        if (off > n || ODO_PARAMS_SIZE > n - off) {
+        if (off > n || ODO_PARAMS_HEADER_SIZE > n - off) {
             snprintf(err, errlen, "%s: truncated ELF: section .odo_params (offset %llu) lies beyond the end of "
                                   "the file (%zu bytes)", path, (unsigned long long)off, n);
             return -1;
@@ -189,14 +207,23 @@ static int load_elf(img_t *img, const char *path, char *err, size_t errlen)
             snprintf(err, errlen, "%s: section .odo_params does not start with the magic 'ODOP'", path);
             return -1;
         }
-        odo_params_t p;
-        const odo_params_status_t st = odo_params_parse(blk, ODO_PARAMS_SIZE, &p);
-        if (st == ODO_PARAMS_ERR_VERSION || st == ODO_PARAMS_ERR_LENGTH) {
-            snprintf(err, errlen, "%s: .odo_params holds layout version %u, length %u; this tool knows version "
-                                  "%u, length %u", path, (unsigned)rd_le(blk + 4, 2), (unsigned)rd_le(blk + 6, 2),
-                     ODO_PARAMS_VERSION, ODO_PARAMS_SIZE);
+        const size_t want = odo_params_version_size((uint16_t)rd_le(blk + 4, 2));
+        if (want == 0U || rd_le(blk + 6, 2) != want) {
+            snprintf(err, errlen, "%s: .odo_params holds layout version %u, length %u; this tool reads %s", path,
+                     (unsigned)rd_le(blk + 4, 2), (unsigned)rd_le(blk + 6, 2), known_layouts());
             return -1;
         }
+        if (size < want) {
+            snprintf(err, errlen, "%s: section .odo_params is %llu bytes, its version-%u block needs %zu", path,
+                     (unsigned long long)size, (unsigned)rd_le(blk + 4, 2), want);
+            return -1;
+        }
+        if (want > n - off) {
+            snprintf(err, errlen, "%s: truncated ELF: section .odo_params (offset %llu) lies beyond the end of "
+                                  "the file (%zu bytes)", path, (unsigned long long)off, n);
+            return -1;
+        }
+        img->block_len = want;
         return 0;
     }
 #undef SH
@@ -390,7 +417,7 @@ int img_load(const char *path, img_t *img, char *err, size_t errlen)
         img->fmt = IMG_ELF;
         rc = load_elf(img, path, err, errlen);
         if (rc == 0) {
-            memcpy(img->block, b + img->block_file_off, ODO_PARAMS_SIZE);
+            memcpy(img->block, b + img->block_file_off, img->block_len);
         }
     } else if (k < img->file_len && b[k] == ':') {
         img->fmt = IMG_HEX;
@@ -403,7 +430,8 @@ int img_load(const char *path, img_t *img, char *err, size_t errlen)
         }
         if (rc == 0) {
             img->block_addr = base + off;
-            memcpy(img->block, flat + off, ODO_PARAMS_SIZE);
+            img->block_len = odo_params_version_size((uint16_t)rd_le(flat + off + 4, 2));
+            memcpy(img->block, flat + off, img->block_len);
         }
         free(flat);
         free(valid);
@@ -414,18 +442,17 @@ int img_load(const char *path, img_t *img, char *err, size_t errlen)
         if (rc == 0) {
             img->block_file_off = off;
             img->block_addr = off;
-            memcpy(img->block, b + off, ODO_PARAMS_SIZE);
+            img->block_len = odo_params_version_size((uint16_t)rd_le(b + off + 4, 2));
+            memcpy(img->block, b + off, img->block_len);
         }
     }
     if (rc != 0) {
         img_free(img);
         return -1;
     }
+    img->version = (unsigned)rd_le(img->block + 4, 2);
     odo_params_t p;
-    img->status = odo_params_parse(img->block, ODO_PARAMS_SIZE, &p);
-    if (img->status == ODO_PARAMS_OK) {
-        img->status = odo_params_decode(img->block, ODO_PARAMS_SIZE, &p);
-    }
+    img->status = odo_params_decode(img->block, img->block_len, &p);
     return 0;
 }
 
@@ -446,6 +473,14 @@ static void put_hex(uint8_t *p, unsigned v)
 int img_write_patched(const img_t *img, const uint8_t block[ODO_PARAMS_SIZE], const char *out_path, char *err,
                       size_t errlen)
 {
+    if (img->block_len != ODO_PARAMS_SIZE) {
+        /* The firmware in the image reads its own layout only, and has room for that many bytes. */
+        snprintf(err, errlen, "the image holds a version-%u parameter block (%zu bytes): its firmware reads that "
+                              "layout only, and this tool writes version %u (%u bytes); rebuild the image with a "
+                              "firmware that reads version %u, or write it with the odo-calib of its own release",
+                 img->version, img->block_len, ODO_PARAMS_VERSION, ODO_PARAMS_SIZE, ODO_PARAMS_VERSION);
+        return -1;
+    }
     uint8_t *out = malloc(img->file_len ? img->file_len : 1);
     if (out == NULL) {
         snprintf(err, errlen, "out of memory");

@@ -10,6 +10,11 @@
 ///   ELF       32- or 64-bit little-endian; the block is the start of section `.odo_params`
 ///             (hal/cortexm/odo_cm4.ld puts it alone at 0x08004000).
 ///
+/// Blocks of layout version 1 (128 bytes) and 2 (256 bytes) are found and read; a block is
+/// written only over a version-2 block (the firmware in an image reads its own layout only, and
+/// has room for its own size), so a version-1 image is refused, never half-upgraded. A block with
+/// a good CRC but a version or length this tool does not know is refused as "another layout".
+///
 /// Host C; reentrant; the image lives in memory (files up to 64 MiB).
 #ifndef CALIB_IMAGE_H
 #define CALIB_IMAGE_H
@@ -34,8 +39,10 @@ typedef struct {
     size_t         file_len;
     uint64_t       block_addr; ///< ELF/HEX: address; BIN: file offset
     size_t         block_file_off; ///< BIN/ELF: file offset of the block
-    uint8_t        block[ODO_PARAMS_SIZE];
-    odo_params_status_t status; ///< odo_params_parse of the block found
+    uint8_t        block[ODO_PARAMS_SIZE]; ///< the block found: block_len bytes, zeros after
+    size_t         block_len;  ///< its declared size: ODO_PARAMS_V1_SIZE or ODO_PARAMS_SIZE
+    unsigned       version;    ///< its layout version (1 or 2)
+    odo_params_status_t status; ///< odo_params_decode of the block found
     unsigned       mode;       ///< the file's permission bits
     /* HEX only */
     img_hex_rec_t *rec;
@@ -43,17 +50,20 @@ typedef struct {
 } img_t;
 
 /// Read and locate the block. Returns 0 with *img filled (img->status says whether the block
-/// parses: OK, or CRC/RANGE for a located but damaged block), or -1 with a message: unreadable,
-/// no block, wrong layout or version, truncated, malformed HEX/ELF, ambiguous. Free with img_free.
+/// decodes: OK, or CRC/RANGE for a located but damaged or out-of-range block), or -1 with a
+/// message: unreadable, no block, unknown layout or version, truncated, malformed HEX/ELF,
+/// ambiguous. Free with img_free.
 int img_load(const char *path, img_t *img, char *err, size_t errlen);
 
 void img_free(img_t *img);
 
 const char *img_format_name(img_format_t f);
 
-/// Write the image with `block` in place of the old one to `out_path`: a temporary file in the
-/// same directory, flushed, read back and checked, then renamed over out_path (keeping the source
-/// file's permission bits). On any error nothing but the old state remains. Returns 0, or -1.
+/// Write the image with `block` (a current-version block, ODO_PARAMS_SIZE bytes) in place of the
+/// old one to `out_path`: a temporary file in the same directory, flushed, read back and checked,
+/// then renamed over out_path (keeping the source file's permission bits). Refused (-1) when the
+/// image holds a block of another size (a version-1 image). On any error nothing but the old
+/// state remains. Returns 0, or -1.
 int img_write_patched(const img_t *img, const uint8_t block[ODO_PARAMS_SIZE], const char *out_path, char *err,
                       size_t errlen);
 

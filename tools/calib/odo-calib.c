@@ -18,6 +18,7 @@
 #include "acceptance.h"
 #include "calib_core.h"
 #include "image.h"
+#include "params_diag.h"
 #include "params_json.h"
 #include "returns_csv.h"
 #include "robot.h"
@@ -41,7 +42,7 @@ static void usage(FILE *f)
             "  write --image FW --params P.json|P.bin [--out OUT] [--force]\n"
             "      put the parameter block into a firmware image (raw .bin, Intel HEX or ELF\n"
             "      .odo_params); CRC recomputed; in place unless --out.\n"
-            "  read --image FW [--json]     print the image's parameter block\n"
+            "  read --image FW [--json]     print the image's parameter block (version 1 or 2)\n"
             "  verify --image FW            check the image's block (layout, version, CRC, ranges)\n"
             "  export --params P.json|P.bin --format ros2\n"
             "      diff_drive_controller multipliers (YAML) for ros2_controllers\n"
@@ -353,11 +354,13 @@ static int cmd_write(int argc, char **argv)
                 "usage: odo-calib write --image FW --params P.json|P.bin [--out OUT] [--force]\n"
                 "\n"
                 "Replace the parameter block inside a firmware image: raw .bin (found by its magic), Intel\n"
-                "HEX, or ELF (section .odo_params). The image's block must have this tool's layout and\n"
-                "version (and a good CRC unless --force). The new block is encoded by the firmware's own\n"
-                "codec (CRC-32 recomputed) and written to OUT (default: FW itself) through a temporary\n"
-                "file that is read back before it is renamed into place; on any error FW and OUT keep\n"
-                "their old content.\n")) {
+                "HEX, or ELF (section .odo_params). The image's block must be a version-2 block (a\n"
+                "version-1 image is refused: its firmware cannot read version 2) with a good CRC unless\n"
+                "--force. P may be a version-1 or version-2 JSON or raw block; a version-1 one is written\n"
+                "as version 2 with scrub_q30 = 0. The new block is encoded by the firmware's own codec\n"
+                "(CRC-32 recomputed) and written to OUT (default: FW itself) through a temporary file\n"
+                "that is read back before it is renamed into place; on any error FW and OUT keep their\n"
+                "old content.\n")) {
         return 0;
     }
     opt_t o[] = {{"--image", 1, NULL}, {"--params", 1, NULL}, {"--out", 1, NULL}, {"--force", 0, NULL}};
@@ -393,9 +396,9 @@ static int cmd_write(int argc, char **argv)
     if (rc != 0) {
         fprintf(stderr, "%s write: %s\n", k_prog, err);
     } else {
-        fprintf(stderr, "%s: wrote the parameter block (CRC-32 0x%08" PRIX32 ") at 0x%llx of %s image %s\n", k_prog,
-                odo_crc32(block, ODO_PARAMS_CRC_OFFSET), (unsigned long long)img.block_addr, img_format_name(img.fmt),
-                out != NULL ? out : image);
+        fprintf(stderr, "%s: wrote the version-%u parameter block (CRC-32 0x%08" PRIX32 ") at 0x%llx of %s image %s\n",
+                k_prog, ODO_PARAMS_VERSION, odo_crc32(block, ODO_PARAMS_CRC_OFFSET), (unsigned long long)img.block_addr,
+                img_format_name(img.fmt), out != NULL ? out : image);
     }
     img_free(&img);
     return rc == 0 ? 0 : EXIT_FAIL;
@@ -423,10 +426,31 @@ static int load_image_cmd(const char *cmd, int argc, char **argv, img_t *img, in
     return 0;
 }
 
+/// The image's block, decoded; on failure a message naming the field (params_diag.h), exit code.
+static int decode_image_block(const char *cmd, const img_t *img, odo_params_t *p)
+{
+    const odo_params_status_t st = odo_params_decode(img->block, img->block_len, p);
+    if (st == ODO_PARAMS_OK) {
+        return 0;
+    }
+    char field[64], detail[192];
+    odo_params_explain(st, img->block, img->block_len, field, sizeof field, detail, sizeof detail);
+    fprintf(stderr, "%s %s: %s image: block at 0x%llx: %s%s%s\n", k_prog, cmd, img_format_name(img->fmt),
+            (unsigned long long)img->block_addr, odo_params_status_str(st), detail[0] != '\0' ? ": " : "", detail);
+    return EXIT_FAIL;
+}
+
+static uint32_t stored_crc(const img_t *img)
+{
+    const uint8_t *c = img->block + img->block_len - 4U;
+    return (uint32_t)c[0] | (uint32_t)c[1] << 8 | (uint32_t)c[2] << 16 | (uint32_t)c[3] << 24;
+}
+
 static int cmd_read(int argc, char **argv)
 {
     if (help_if(argc, argv, "usage: odo-calib read --image FW [--json]\n\nPrint the parameter block of a firmware "
-                            "image (.bin, Intel HEX, ELF); --json in the shape `odo-params show` prints.\n")) {
+                            "image (.bin, Intel HEX, ELF), version 1 or 2; --json in the shape `odo-params show` "
+                            "prints (a version-1 block without scrub_q30).\n")) {
         return 0;
     }
     img_t img;
@@ -436,34 +460,28 @@ static int cmd_read(int argc, char **argv)
         return rc;
     }
     odo_params_t p;
-    const odo_params_status_t st = odo_params_decode(img.block, ODO_PARAMS_SIZE, &p);
-    if (st != ODO_PARAMS_OK) {
-        fprintf(stderr, "%s read: block at 0x%llx: %s\n", k_prog, (unsigned long long)img.block_addr,
-                odo_params_status_str(st));
+    if (decode_image_block("read", &img, &p) != 0) {
         img_free(&img);
         return EXIT_FAIL;
     }
     if (json) {
-        odo_params_json_write(stdout, &p);
+        odo_params_json_write_stored(stdout, &p, img.version, stored_crc(&img));
     } else {
-        const odo_truck_params_t *t = &p.truck[0];
-        double cl = 0, cr = 0;
-        int32_t cl_q = 0, cr_q = 0;
-        (void)odo_umb_correction_factors(t->ed_q30, &cl_q, &cr_q);
-        cl = cl_q / Q30;
-        cr = cr_q / Q30;
         printf("%s image, parameter block at 0x%llx, version %u, CRC-32 0x%08" PRIX32 "\n", img_format_name(img.fmt),
-               (unsigned long long)img.block_addr, ODO_PARAMS_VERSION,
-               (uint32_t)(img.block[124] | img.block[125] << 8 | img.block[126] << 16 | (uint32_t)img.block[127] << 24));
+               (unsigned long long)img.block_addr, img.version, stored_crc(&img));
         for (unsigned k = 0; k < ODO_TRUCKS; ++k) {
-            t = &p.truck[k];
+            const odo_truck_params_t *t = &p.truck[k];
+            int32_t cl_q = 0, cr_q = 0;
             (void)odo_umb_correction_factors(t->ed_q30, &cl_q, &cr_q);
-            cl = cl_q / Q30;
-            cr = cr_q / Q30;
-            printf("truck %c: Dn %.4f mm, b %.4f mm, counts/rev %.3f, Ed %.7f, Eb %.7f, Es %.7f (cL %.7f, cR %.7f, "
-                   "b_actual %.4f mm)\n", 'A' + k, t->wheel_diameter_nm / 1e6, t->wheelbase_nm / 1e6,
-                   t->counts_per_rev_milli / 1e3, t->ed_q30 / Q30, t->eb_q30 / Q30, t->es_q30 / Q30, cl, cr,
+            printf("truck %c: Dn %.4f mm, b %.4f mm, counts/rev %.3f, Ed %.7f, Eb %.7f, Es %.7f, scrub k %.7f "
+                   "(cL %.7f, cR %.7f, b_actual %.4f mm on spot turns)\n", 'A' + k, t->wheel_diameter_nm / 1e6,
+                   t->wheelbase_nm / 1e6, t->counts_per_rev_milli / 1e3, t->ed_q30 / Q30, t->eb_q30 / Q30,
+                   t->es_q30 / Q30, t->scrub_q30 / Q30, cl_q / Q30, cr_q / Q30,
                    t->wheelbase_nm / 1e6 * (t->eb_q30 / Q30));
+        }
+        if (img.version < ODO_PARAMS_VERSION) {
+            printf("(a version-%u block: scrub_q30 reads as 0; `odo-calib write` refuses this image, whose firmware "
+                   "reads version %u only)\n", img.version, img.version);
         }
     }
     img_free(&img);
@@ -473,8 +491,9 @@ static int cmd_read(int argc, char **argv)
 static int cmd_verify(int argc, char **argv)
 {
     if (help_if(argc, argv, "usage: odo-calib verify --image FW\n\nCheck the parameter block of a firmware image as "
-                            "the firmware does at boot (magic, version, length, CRC-32, every range). Exit 0 iff "
-                            "the firmware would accept it.\n")) {
+                            "the firmware does at boot (magic, version 1 or 2, length, CRC-32, every range, reserved "
+                            "bytes zero). Exit 0 iff the firmware would accept it; otherwise the message names the "
+                            "offending field.\n")) {
         return 0;
     }
     img_t img;
@@ -483,15 +502,12 @@ static int cmd_verify(int argc, char **argv)
         return rc;
     }
     odo_params_t p;
-    const odo_params_status_t st = odo_params_decode(img.block, ODO_PARAMS_SIZE, &p);
-    if (st != ODO_PARAMS_OK) {
-        fprintf(stderr, "%s verify: %s image: block at 0x%llx: %s\n", k_prog, img_format_name(img.fmt),
-                (unsigned long long)img.block_addr, odo_params_status_str(st));
+    if (decode_image_block("verify", &img, &p) != 0) {
         img_free(&img);
         return EXIT_FAIL;
     }
     printf("ok: %s image, parameter block at 0x%llx, version %u, CRC-32 good, every field in range\n",
-           img_format_name(img.fmt), (unsigned long long)img.block_addr, ODO_PARAMS_VERSION);
+           img_format_name(img.fmt), (unsigned long long)img.block_addr, img.version);
     img_free(&img);
     return 0;
 }

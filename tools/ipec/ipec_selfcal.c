@@ -19,6 +19,7 @@ void ipec_apply_params(sim_robot_t *r, const odo_params_t *p)
         r->truck[t].cal_ed = p->truck[t].ed_q30 / TWO30;
         r->truck[t].cal_eb = p->truck[t].eb_q30 / TWO30;
         r->truck[t].cal_es = p->truck[t].es_q30 / TWO30;
+        r->truck[t].cal_scrub = p->truck[t].scrub_q30 / TWO30;
         r->truck[t].has_calibration = true;
     }
     r->link.cal_alpha_bias_deg = ipec_bam_deg(p->link.alpha_bias_bam);

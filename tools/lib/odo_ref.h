@@ -1,6 +1,6 @@
-/// Double-precision reference odometry (000 Eqs. 2.1-2.6, 6.28, 6.33-6.35, App. B), written
-/// straight from the equations with no fixed-point tricks. The firmware is checked against it;
-/// never the reverse.
+/// Double-precision reference odometry (000 Eqs. 2.1-2.6, 6.28, 6.33-6.35, App. B, and the
+/// tyre-scrub factor on Eq. 2.4 of odo_odometry.h), written straight from the equations with no
+/// fixed-point tricks. The firmware is checked against it; never the reverse.
 #ifndef ODO_REF_H
 #define ODO_REF_H
 
@@ -12,6 +12,7 @@ typedef struct {
     double x_mm, y_mm, theta_rad; ///< pose; theta unwrapped
     double k_mm[2];               ///< distance per count, cL/R * cm
     double b_eff_mm;              ///< Eb * b
+    double scrub;                 ///< k: dtheta *= 1 - k m / v (odo_odometry.h)
     int    paper_form;            ///< 1: advance along the new heading (Eq. 2.6); 0: midpoint
 } odo_ref_t;
 

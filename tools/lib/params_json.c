@@ -8,52 +8,39 @@
 #include <stdlib.h>
 #include <string.h>
 
-typedef enum { F_U8, F_U16, F_U32, F_I32 } ftype_t;
+#include "params_diag.h"
 
-typedef struct {
-    const char *key;
-    ftype_t     type;
-    size_t      off;
-} field_t;
+#define LINK_PREFIX "link."
 
-#define TOP(k, t) {#k, t, offsetof(odo_params_t, k)}
-#define TRK(k, t) {#k, t, offsetof(odo_truck_params_t, k)}
-#define LNK(k, t) {#k, t, offsetof(odo_link_params_t, k)}
-
-static const field_t k_top[] = {
-    TOP(vehicle, F_U8), TOP(counter_bits, F_U8), TOP(heading_form, F_U8), TOP(ipec_mode, F_U8),
-    TOP(tick_us, F_U32), TOP(max_wheel_speed_mm_s, F_U32),
-};
-static const field_t k_truck[] = {
-    TRK(wheel_diameter_nm, F_U32), TRK(counts_per_rev_milli, F_U32), TRK(wheelbase_nm, F_U32),
-    TRK(ed_q30, F_I32), TRK(eb_q30, F_I32), TRK(es_q30, F_I32), TRK(flags, F_U8),
-};
-static const field_t k_link[] = {
-    LNK(length_nm, F_U32), LNK(hitch_offset_nm, F_U32), LNK(length_bias_nm, F_I32),
-    LNK(length_ecc_nm, F_I32), LNK(alpha_bias_bam, F_I32), LNK(beta_bias_bam, F_I32),
-    LNK(rotary_bits, F_U8), LNK(stale_ticks, F_U16), LNK(max_jump_bam, F_U32),
-    LNK(max_length_jump_um, F_U32), LNK(length_min_um, F_U32), LNK(length_max_um, F_U32),
-};
-#define N(a) (sizeof(a) / sizeof((a)[0]))
-
-static int find_field(const field_t *f, size_t n, const char *key)
+/// The key a field has inside its JSON object: link fields drop their "link." prefix.
+static const char *json_key(const odo_param_field_info_t *f)
 {
-    for (size_t i = 0; i < n; ++i) {
-        if (strcmp(f[i].key, key) == 0) {
-            return (int)i;
-        }
-    }
-    return -1;
+    return f->scope == (uint8_t)ODO_PSCOPE_LINK ? f->name + strlen(LINK_PREFIX) : f->name;
 }
 
-/// Read every field of table f from object o into base; unknown keys (other than `allowed`) fail.
-static int read_fields(json_t *o, const field_t *f, size_t n, void *base, const char *origin,
-                       const char *prefix, const char *const *allowed, char *err, size_t errlen)
+static const odo_param_field_info_t *find_field(odo_param_scope_t scope, const char *key)
+{
+    for (size_t i = 0; i < odo_params_field_count(); ++i) {
+        const odo_param_field_info_t *f = odo_params_field_at(i);
+        if (f->scope == (uint8_t)scope && strcmp(json_key(f), key) == 0) {
+            return f;
+        }
+    }
+    return NULL;
+}
+
+/// Read the fields of `scope` (instance `truck`) from object o into *p for layout `version`:
+/// every field the version carries is required, one it does not carry must be absent, and any
+/// key that is neither a field nor in `allowed` fails.
+static int read_fields(json_t *o, odo_param_scope_t scope, uint8_t truck, unsigned version, odo_params_t *p,
+                       const char *origin, const char *prefix, const char *const *allowed, char *err,
+                       size_t errlen)
 {
     const char *key;
     json_t *v;
     json_object_foreach(o, key, v) {
-        int known = find_field(f, n, key) >= 0;
+        const odo_param_field_info_t *f = find_field(scope, key);
+        int known = f != NULL;
         for (const char *const *a = allowed; !known && a != NULL && *a != NULL; ++a) {
             known = strcmp(*a, key) == 0;
         }
@@ -61,37 +48,40 @@ static int read_fields(json_t *o, const field_t *f, size_t n, void *base, const 
             snprintf(err, errlen, "%s: %s%s: unknown key", origin, prefix, key);
             return -1;
         }
+        if (f != NULL && f->since > version) {
+            snprintf(err, errlen, "%s: %s%s: not part of a version-%u block (it came with version %u)", origin,
+                     prefix, key, version, f->since);
+            return -1;
+        }
     }
-    for (size_t i = 0; i < n; ++i) {
-        json_t *x = json_object_get(o, f[i].key);
+    for (size_t i = 0; i < odo_params_field_count(); ++i) {
+        const odo_param_field_info_t *f = odo_params_field_at(i);
+        if (f->scope != (uint8_t)scope || f->since > version) {
+            continue;
+        }
+        json_t *x = json_object_get(o, json_key(f));
         if (x == NULL) {
-            snprintf(err, errlen, "%s: %s%s: missing", origin, prefix, f[i].key);
+            snprintf(err, errlen, "%s: %s%s: missing", origin, prefix, json_key(f));
             return -1;
         }
         if (!json_is_integer(x)) {
-            snprintf(err, errlen, "%s: %s%s: must be an integer", origin, prefix, f[i].key);
+            snprintf(err, errlen, "%s: %s%s: must be an integer", origin, prefix, json_key(f));
             return -1;
         }
         const json_int_t val = json_integer_value(x);
         long long lo = 0, hi = 0;
-        switch (f[i].type) {
-        case F_U8: hi = UINT8_MAX; break;
-        case F_U16: hi = UINT16_MAX; break;
-        case F_U32: hi = UINT32_MAX; break;
-        case F_I32: lo = INT32_MIN; hi = INT32_MAX; break;
+        switch ((odo_param_type_t)f->type) {
+        case ODO_PTYPE_U8: hi = UINT8_MAX; break;
+        case ODO_PTYPE_U16: hi = UINT16_MAX; break;
+        case ODO_PTYPE_U32: hi = UINT32_MAX; break;
+        case ODO_PTYPE_I32: lo = INT32_MIN; hi = INT32_MAX; break;
         }
         if (val < lo || val > hi) {
             snprintf(err, errlen, "%s: %s%s: %lld does not fit its field [%lld, %lld]", origin, prefix,
-                     f[i].key, (long long)val, lo, hi);
+                     json_key(f), (long long)val, lo, hi);
             return -1;
         }
-        unsigned char *dst = (unsigned char *)base + f[i].off;
-        switch (f[i].type) {
-        case F_U8: { const uint8_t t = (uint8_t)val; memcpy(dst, &t, sizeof t); break; }
-        case F_U16: { const uint16_t t = (uint16_t)val; memcpy(dst, &t, sizeof t); break; }
-        case F_U32: { const uint32_t t = (uint32_t)val; memcpy(dst, &t, sizeof t); break; }
-        case F_I32: { const int32_t t = (int32_t)val; memcpy(dst, &t, sizeof t); break; }
-        }
+        (void)odo_params_set(p, (odo_param_field_t)f->id, truck, (int64_t)val);
     }
     return 0;
 }
@@ -109,6 +99,7 @@ int odo_params_json_parse(const char *text, const char *origin, odo_params_t *ou
     odo_params_defaults(&p);
     static const char *const k_meta[] = {"file", "status", "magic", "version", "length", "crc32",
                                          "comment", "truck", "link", NULL};
+    unsigned version = ODO_PARAMS_VERSION;
     if (!json_is_object(root)) {
         snprintf(err, errlen, "%s: the top level must be an object", origin);
         goto done;
@@ -125,17 +116,19 @@ int odo_params_json_parse(const char *text, const char *origin, odo_params_t *ou
         snprintf(err, errlen, "%s: magic: must be \"ODOP\"", origin);
         goto done;
     }
-    if (ve != NULL && !(json_is_integer(ve) && json_integer_value(ve) == ODO_PARAMS_VERSION)) {
-        snprintf(err, errlen, "%s: version: this tool writes layout version %u only", origin,
-                 ODO_PARAMS_VERSION);
+    if (ve != NULL) {
+        if (!json_is_integer(ve) || json_integer_value(ve) < 1 || json_integer_value(ve) > ODO_PARAMS_VERSION) {
+            snprintf(err, errlen, "%s: version: this tool reads layout versions 1 to %u", origin, ODO_PARAMS_VERSION);
+            goto done;
+        }
+        version = (unsigned)json_integer_value(ve);
+    }
+    const size_t size = odo_params_version_size((uint16_t)version);
+    if (le != NULL && !(json_is_integer(le) && json_integer_value(le) == (json_int_t)size)) {
+        snprintf(err, errlen, "%s: length: a version-%u block is %zu bytes", origin, version, size);
         goto done;
     }
-    if (le != NULL && !(json_is_integer(le) && json_integer_value(le) == ODO_PARAMS_SIZE)) {
-        snprintf(err, errlen, "%s: length: a version-%u block is %u bytes", origin, ODO_PARAMS_VERSION,
-                 ODO_PARAMS_SIZE);
-        goto done;
-    }
-    if (read_fields(root, k_top, N(k_top), &p, origin, "", k_meta, err, errlen) != 0) {
+    if (read_fields(root, ODO_PSCOPE_TOP, 0, version, &p, origin, "", k_meta, err, errlen) != 0) {
         goto done;
     }
     json_t *tr = json_object_get(root, "truck");
@@ -151,7 +144,7 @@ int odo_params_json_parse(const char *text, const char *origin, odo_params_t *ou
             snprintf(err, errlen, "%s: truck[%zu]: must be an object", origin, t);
             goto done;
         }
-        if (read_fields(o, k_truck, N(k_truck), &p.truck[t], origin, prefix, NULL, err, errlen) != 0) {
+        if (read_fields(o, ODO_PSCOPE_TRUCK, (uint8_t)t, version, &p, origin, prefix, NULL, err, errlen) != 0) {
             goto done;
         }
     }
@@ -160,18 +153,15 @@ int odo_params_json_parse(const char *text, const char *origin, odo_params_t *ou
         snprintf(err, errlen, "%s: link: must be an object", origin);
         goto done;
     }
-    if (read_fields(lk, k_link, N(k_link), &p.link, origin, "link.", NULL, err, errlen) != 0) {
+    if (read_fields(lk, ODO_PSCOPE_LINK, 0, version, &p, origin, LINK_PREFIX, NULL, err, errlen) != 0) {
         goto done;
     }
     odo_param_field_t bad = ODO_PF_NONE;
     uint8_t bad_truck = 0;
     if (odo_params_validate(&p, &bad, &bad_truck) != ODO_PARAMS_OK) {
-        if (bad >= ODO_PF_WHEEL_DIAMETER && bad <= ODO_PF_TRUCK_FLAGS) {
-            snprintf(err, errlen, "%s: truck[%u].%s: outside the documented range (odo_params.h)", origin,
-                     (unsigned)bad_truck, odo_params_field_name(bad));
-        } else {
-            snprintf(err, errlen, "%s: %s: outside the documented range (odo_params.h)", origin, odo_params_field_name(bad));
-        }
+        char name[64];
+        odo_params_qualified_name(bad, bad_truck, name, sizeof name);
+        snprintf(err, errlen, "%s: %s: outside the documented range (odo_params.h)", origin, name);
         goto done;
     }
     *out = p;
@@ -235,12 +225,21 @@ int odo_params_file_load(const char *path, odo_params_t *p, char *err, size_t er
     }
     int rc;
     if (n >= 4 && memcmp(buf, "ODOP", 4) == 0) {
+        /* A raw block of any version this firmware reads (a version-1 block reads with scrub 0);
+         * the file must be exactly the block. */
+        const uint8_t *b = (const uint8_t *)buf;
+        const size_t want = n >= ODO_PARAMS_HEADER_SIZE ? odo_params_version_size((uint16_t)(b[4] | b[5] << 8)) : 0U;
         odo_params_t q;
-        const odo_params_status_t st = n == ODO_PARAMS_SIZE ? odo_params_decode((const uint8_t *)buf, n, &q)
-                                                             : ODO_PARAMS_ERR_SHORT;
+        const odo_params_status_t st = odo_params_decode(b, n, &q);
         if (st != ODO_PARAMS_OK) {
-            snprintf(err, errlen, "%s: not a valid %u-byte parameter block (%zu bytes): %s", path,
-                     ODO_PARAMS_SIZE, n, n == ODO_PARAMS_SIZE ? odo_params_status_str(st) : "wrong size");
+            char field[64], detail[192];
+            odo_params_explain(st, b, n, field, sizeof field, detail, sizeof detail);
+            snprintf(err, errlen, "%s: not a valid parameter block (%zu bytes): %s%s%s", path, n,
+                     odo_params_status_str(st), detail[0] != '\0' ? ": " : "", detail);
+            rc = -1;
+        } else if (n != want) {
+            snprintf(err, errlen, "%s: %zu bytes: a raw parameter block file must be exactly its %zu bytes", path,
+                     n, want);
             rc = -1;
         } else {
             *p = q;
@@ -256,41 +255,49 @@ int odo_params_file_load(const char *path, odo_params_t *p, char *err, size_t er
     return rc;
 }
 
-void odo_params_json_fields(FILE *f, const odo_params_t *p)
+/// The fields of one scope (instance `truck`) that layout `version` carries, as `"key": value`
+/// members, comma separated.
+static void write_scope(FILE *f, const odo_params_t *p, odo_param_scope_t scope, uint8_t truck, unsigned version)
 {
-    fprintf(f, " \"vehicle\": %u, \"counter_bits\": %u, \"heading_form\": %u, \"ipec_mode\": %u, "
-               "\"tick_us\": %" PRIu32 ", \"max_wheel_speed_mm_s\": %" PRIu32 ",\n \"truck\": [",
-            p->vehicle, p->counter_bits, p->heading_form, p->ipec_mode, p->tick_us,
-            p->max_wheel_speed_mm_s);
-    for (unsigned t = 0; t < ODO_TRUCKS; t++) {
-        const odo_truck_params_t *tr = &p->truck[t];
-        fprintf(f,
-                "%s\n  {\"wheel_diameter_nm\": %" PRIu32 ", \"counts_per_rev_milli\": %" PRIu32
-                ", \"wheelbase_nm\": %" PRIu32 ", \"ed_q30\": %" PRId32 ", \"eb_q30\": %" PRId32
-                ", \"es_q30\": %" PRId32 ", \"flags\": %u}",
-                t == 0 ? "" : ",", tr->wheel_diameter_nm, tr->counts_per_rev_milli, tr->wheelbase_nm,
-                tr->ed_q30, tr->eb_q30, tr->es_q30, tr->flags);
+    const char *sep = "";
+    for (size_t i = 0; i < odo_params_field_count(); ++i) {
+        const odo_param_field_info_t *fi = odo_params_field_at(i);
+        if (fi->scope != (uint8_t)scope || fi->since > version) {
+            continue;
+        }
+        fprintf(f, "%s\"%s\": %" PRId64, sep, json_key(fi), odo_params_get(p, (odo_param_field_t)fi->id, truck));
+        sep = ", ";
     }
-    const odo_link_params_t *l = &p->link;
-    fprintf(f, "],\n \"link\": {\"length_nm\": %" PRIu32 ", \"hitch_offset_nm\": %" PRIu32
-               ", \"length_bias_nm\": %" PRId32 ", \"length_ecc_nm\": %" PRId32
-               ", \"alpha_bias_bam\": %" PRId32 ", \"beta_bias_bam\": %" PRId32
-               ", \"rotary_bits\": %u, \"stale_ticks\": %u, \"max_jump_bam\": %" PRIu32
-               ", \"max_length_jump_um\": %" PRIu32 ", \"length_min_um\": %" PRIu32
-               ", \"length_max_um\": %" PRIu32 "}",
-            l->length_nm, l->hitch_offset_nm, l->length_bias_nm, l->length_ecc_nm, l->alpha_bias_bam,
-            l->beta_bias_bam, l->rotary_bits, l->stale_ticks, l->max_jump_bam, l->max_length_jump_um,
-            l->length_min_um, l->length_max_um);
+}
+
+void odo_params_json_fields(FILE *f, const odo_params_t *p, unsigned version)
+{
+    fputc(' ', f);
+    write_scope(f, p, ODO_PSCOPE_TOP, 0, version);
+    fputs(",\n \"truck\": [", f);
+    for (unsigned t = 0; t < ODO_TRUCKS; t++) {
+        fprintf(f, "%s\n  {", t == 0 ? "" : ",");
+        write_scope(f, p, ODO_PSCOPE_TRUCK, (uint8_t)t, version);
+        fputc('}', f);
+    }
+    fputs("],\n \"link\": {", f);
+    write_scope(f, p, ODO_PSCOPE_LINK, 0, version);
+    fputc('}', f);
+}
+
+int odo_params_json_write_stored(FILE *f, const odo_params_t *p, unsigned version, uint32_t crc)
+{
+    fprintf(f, "{\"status\": \"ok\", \"magic\": \"ODOP\", \"version\": %u, \"length\": %zu, "
+               "\"crc32\": \"0x%08" PRIX32 "\",\n",
+            version, odo_params_version_size((uint16_t)version), crc);
+    odo_params_json_fields(f, p, version);
+    fputs("}\n", f);
+    return ferror(f) ? -1 : 0;
 }
 
 int odo_params_json_write(FILE *f, const odo_params_t *p)
 {
     uint8_t block[ODO_PARAMS_SIZE];
     (void)odo_params_encode(p, block, sizeof block);
-    fprintf(f, "{\"status\": \"ok\", \"magic\": \"ODOP\", \"version\": %u, \"length\": %u, "
-               "\"crc32\": \"0x%08" PRIX32 "\",\n",
-            ODO_PARAMS_VERSION, ODO_PARAMS_SIZE, odo_crc32(block, ODO_PARAMS_CRC_OFFSET));
-    odo_params_json_fields(f, p);
-    fputs("}\n", f);
-    return ferror(f) ? -1 : 0;
+    return odo_params_json_write_stored(f, p, ODO_PARAMS_VERSION, odo_crc32(block, ODO_PARAMS_CRC_OFFSET));
 }

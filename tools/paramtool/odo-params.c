@@ -1,7 +1,8 @@
 /// odo-params: write and inspect the firmware parameter block (odo/odo_params.h).
 ///
-///   odo-params defaults --out FILE   write the 128-byte default block (FILE.tmp, fsync, rename)
-///   odo-params show FILE             decode FILE and print every field as one JSON object
+///   odo-params defaults --out FILE   write the default block (FILE.tmp, fsync, rename)
+///   odo-params show FILE             decode FILE (version 1 or 2) and print every field as JSON
+///   odo-params layout [--out FILE]   the header's field table (ODO_PARAMS_FIELDS) as JSON
 ///
 /// Exit status: 0 success; 1 a rejected block or an I/O error (message on stderr naming the
 /// reason); 2 a usage error. Encoding, decoding and range checks are the firmware's own
@@ -19,6 +20,7 @@
 #include <unistd.h>
 
 #include "odo/odo_params.h"
+#include "params_diag.h"
 #include "params_json.h"
 
 #define EXIT_REJECTED 1
@@ -34,15 +36,17 @@ static void usage_main(FILE *f)
     fprintf(f,
             "usage: %s <command> [options]\n"
             "\n"
-            "Write and inspect the odometry firmware parameter block (%u bytes, version %u).\n"
+            "Write and inspect the odometry firmware parameter block (%u bytes, version %u;\n"
+            "version-1 blocks of %u bytes are still read).\n"
             "\n"
             "commands:\n"
             "  defaults --out FILE   write the default parameter block to FILE\n"
             "  show FILE             decode FILE, print every field as one JSON object\n"
+            "  layout [--out FILE]   print the block's field table (offsets, widths, ranges) as JSON\n"
             "\n"
             "Run '%s <command> --help' for a command's options.\n"
             "Exit status: 0 ok, 1 rejected block or I/O error, 2 usage error.\n",
-            k_prog, ODO_PARAMS_SIZE, ODO_PARAMS_VERSION, k_prog);
+            k_prog, ODO_PARAMS_SIZE, ODO_PARAMS_VERSION, ODO_PARAMS_V1_SIZE, k_prog);
 }
 
 static void usage_defaults(FILE *f)
@@ -67,11 +71,29 @@ static void usage_show(FILE *f)
             "\n"
             "Decode the parameter block in FILE with the firmware's own decoder (magic, version,\n"
             "length, CRC-32, ranges) and print every field as one JSON object on stdout, with\n"
-            "\"status\": \"ok\". A rejected block prints a JSON object with the status and reason,\n"
-            "a message on stderr naming the reason (and, for a range error, the field), and exits 1.\n"
+            "\"status\": \"ok\". A version-1 block shows as version 1 with scrub_q30 0. A rejected block\n"
+            "prints a JSON object with the status and reason, a message on stderr naming the reason\n"
+            "(and the offending field: version, length, crc32, a field, or a reserved byte), and exits 1.\n"
             "\n"
             "options:\n"
             "  -h, --help   show this help\n",
+            k_prog);
+}
+
+static void usage_layout(FILE *f)
+{
+    fprintf(f,
+            "usage: %s layout [--out FILE]\n"
+            "\n"
+            "Print the parameter block's field table, expanded from ODO_PARAMS_FIELDS in\n"
+            "firmware/include/odo/odo_params.h, as one JSON object: header, sizes and CRC offsets\n"
+            "of every version, and per field its JSON name, scope, offsets (one per truck for truck\n"
+            "fields), width, type, signedness, range, unit and the version that introduced it.\n"
+            "With --out, write it to FILE.tmp and rename it over FILE.\n"
+            "\n"
+            "options:\n"
+            "  -o, --out FILE   output file (default: stdout)\n"
+            "  -h, --help       show this help\n",
             k_prog);
 }
 
@@ -188,43 +210,6 @@ static uint32_t le32(const uint8_t *b)
     return (uint32_t)b[0] | ((uint32_t)b[1] << 8) | ((uint32_t)b[2] << 16) | ((uint32_t)b[3] << 24);
 }
 
-/// The offending value, for the message. Length range: the minimum (the pair is named together).
-static long long field_value(const odo_params_t *p, odo_param_field_t f, unsigned t)
-{
-    const odo_truck_params_t *tr = &p->truck[t < ODO_TRUCKS ? t : 0];
-    switch (f) {
-    case ODO_PF_VEHICLE: return p->vehicle;
-    case ODO_PF_COUNTER_BITS: return p->counter_bits;
-    case ODO_PF_HEADING_FORM: return p->heading_form;
-    case ODO_PF_IPEC_MODE: return p->ipec_mode;
-    case ODO_PF_TICK_US: return p->tick_us;
-    case ODO_PF_MAX_WHEEL_SPEED: return p->max_wheel_speed_mm_s;
-    case ODO_PF_WHEEL_DIAMETER: return tr->wheel_diameter_nm;
-    case ODO_PF_COUNTS_PER_REV: return tr->counts_per_rev_milli;
-    case ODO_PF_WHEELBASE: return tr->wheelbase_nm;
-    case ODO_PF_ED: return tr->ed_q30;
-    case ODO_PF_EB: return tr->eb_q30;
-    case ODO_PF_ES: return tr->es_q30;
-    case ODO_PF_TRUCK_FLAGS: return tr->flags;
-    case ODO_PF_LINK_LENGTH: return p->link.length_nm;
-    case ODO_PF_HITCH_OFFSET: return p->link.hitch_offset_nm;
-    case ODO_PF_LENGTH_BIAS: return p->link.length_bias_nm;
-    case ODO_PF_LENGTH_ECC: return p->link.length_ecc_nm;
-    case ODO_PF_ALPHA_BIAS: return p->link.alpha_bias_bam;
-    case ODO_PF_BETA_BIAS: return p->link.beta_bias_bam;
-    case ODO_PF_ROTARY_BITS: return p->link.rotary_bits;
-    case ODO_PF_STALE_TICKS: return p->link.stale_ticks;
-    case ODO_PF_MAX_JUMP: return p->link.max_jump_bam;
-    case ODO_PF_MAX_LENGTH_JUMP: return p->link.max_length_jump_um;
-    case ODO_PF_LENGTH_RANGE: return p->link.length_min_um;
-    case ODO_PF_NONE:
-    case ODO_PF_RESERVED: break;
-    }
-    return 0;
-}
-
-static bool is_truck_field(odo_param_field_t f) { return f >= ODO_PF_WHEEL_DIAMETER && f <= ODO_PF_TRUCK_FLAGS; }
-
 static const char *status_key(odo_params_status_t s)
 {
     switch (s) {
@@ -258,80 +243,15 @@ static void json_str(FILE *f, const char *s)
 
 static void print_json(FILE *f, const char *path, const uint8_t *b, const odo_params_t *p)
 {
+    /* The block as stored: a version-1 block keeps its version, length and CRC offset. */
+    const size_t crc_off = odo_params_version_size(le16(&b[4])) - 4U;
     fprintf(f, "{\"file\": ");
     json_str(f, path);
     fprintf(f, ", \"status\": \"ok\", \"magic\": \"ODOP\", \"version\": %u, \"length\": %u, "
                "\"crc32\": \"0x%08" PRIX32 "\",\n",
-            (unsigned)le16(&b[4]), (unsigned)le16(&b[6]), le32(&b[ODO_PARAMS_CRC_OFFSET]));
-    odo_params_json_fields(f, p);
+            (unsigned)le16(&b[4]), (unsigned)le16(&b[6]), le32(&b[crc_off]));
+    odo_params_json_fields(f, p, le16(&b[4]));
     fputs("}\n", f);
-}
-
-/// Explain a rejected block: detail[] gets the specifics, field[] the offending field (range only).
-static void diagnose(odo_params_status_t st, const uint8_t *b, size_t n, char *detail, size_t dcap,
-                     char *field, size_t fcap)
-{
-    detail[0] = '\0';
-    field[0] = '\0';
-    switch (st) {
-    case ODO_PARAMS_ERR_SHORT:
-        snprintf(detail, dcap, "%zu bytes, a version-%u block is %u", n, ODO_PARAMS_VERSION,
-                 ODO_PARAMS_SIZE);
-        break;
-    case ODO_PARAMS_ERR_MAGIC:
-        snprintf(detail, dcap, "first bytes %02X %02X %02X %02X, expected 4F 44 4F 50 ('ODOP')", b[0],
-                 b[1], b[2], b[3]);
-        break;
-    case ODO_PARAMS_ERR_VERSION:
-        snprintf(detail, dcap, "version %u, this tool knows %u", (unsigned)le16(&b[4]),
-                 ODO_PARAMS_VERSION);
-        break;
-    case ODO_PARAMS_ERR_LENGTH:
-        snprintf(detail, dcap, "declared length %u, version %u blocks are %u", (unsigned)le16(&b[6]),
-                 ODO_PARAMS_VERSION, ODO_PARAMS_SIZE);
-        break;
-    case ODO_PARAMS_ERR_CRC:
-        snprintf(detail, dcap, "stored CRC-32 0x%08" PRIX32 ", computed 0x%08" PRIX32,
-                 le32(&b[ODO_PARAMS_CRC_OFFSET]), odo_crc32(b, ODO_PARAMS_CRC_OFFSET));
-        break;
-    case ODO_PARAMS_ERR_RANGE: {
-        /* Header and CRC are good: parse without range checks, then let the firmware's own
-         * validator name the field. A parse that fails on range means a reserved byte: find it
-         * by re-encoding (encode writes reserved bytes as 0). */
-        odo_params_t p;
-        odo_param_field_t f = ODO_PF_NONE;
-        uint8_t t = 0;
-        if (odo_params_parse(b, n, &p) == ODO_PARAMS_ERR_RANGE) {
-            uint8_t re[ODO_PARAMS_SIZE];
-            (void)odo_params_encode(&p, re, sizeof re);
-            for (unsigned i = 0; i < ODO_PARAMS_CRC_OFFSET; i++) {
-                if (re[i] != b[i]) {
-                    snprintf(field, fcap, "reserved");
-                    snprintf(detail, dcap, "reserved byte at offset %u is 0x%02X, must be 0", i, b[i]);
-                    break;
-                }
-            }
-            break;
-        }
-        (void)odo_params_validate(&p, &f, &t);
-        if (is_truck_field(f)) {
-            snprintf(field, fcap, "truck[%u].%s", (unsigned)t, odo_params_field_name(f));
-        } else {
-            snprintf(field, fcap, "%s", odo_params_field_name(f));
-        }
-        if (f == ODO_PF_LENGTH_RANGE) {
-            snprintf(detail, dcap, "field %s = %" PRIu32 "/%" PRIu32 " is outside its documented range",
-                     field, p.link.length_min_um, p.link.length_max_um);
-        } else {
-            snprintf(detail, dcap, "field %s = %lld is outside its documented range", field,
-                     field_value(&p, f, t));
-        }
-        break;
-    }
-    case ODO_PARAMS_OK:
-    case ODO_PARAMS_ERR_ARG:
-        break;
-    }
 }
 
 static int cmd_show(int argc, char **argv)
@@ -394,9 +314,9 @@ static int cmd_show(int argc, char **argv)
         return 0;
     }
 
-    char detail[160];
+    char detail[192];
     char field[64];
-    diagnose(st, buf, n, detail, sizeof detail, field, sizeof field);
+    odo_params_explain(st, buf, n, field, sizeof field, detail, sizeof detail);
     printf("{\"file\": ");
     json_str(stdout, path);
     printf(", \"status\": \"%s\", \"reason\": ", status_key(st));
@@ -416,6 +336,93 @@ static int cmd_show(int argc, char **argv)
     return EXIT_REJECTED;
 }
 
+/* ---------------------------------------------------------------------------------------------
+ * layout: ODO_PARAMS_FIELDS as data, for Python and the image checks (one source, no copies)
+ * ------------------------------------------------------------------------------------------- */
+static const char *scope_key(const char *scope)
+{
+    return strcmp(scope, "TRUCK") == 0 ? "truck" : strcmp(scope, "LINK") == 0 ? "link" : "top";
+}
+
+static void print_layout(FILE *f)
+{
+    fprintf(f, "{\"magic\": \"ODOP\", \"magic_u32\": %lu, \"version\": %u, \"size\": %u, "
+               "\"crc_offset\": %u, \"header_size\": %u, \"trucks\": %u,\n",
+            (unsigned long)ODO_PARAMS_MAGIC, ODO_PARAMS_VERSION, ODO_PARAMS_SIZE, ODO_PARAMS_CRC_OFFSET,
+            ODO_PARAMS_HEADER_SIZE, (unsigned)ODO_TRUCKS);
+    fputs(" \"versions\": [", f);
+    for (unsigned v = 1U; v <= ODO_PARAMS_VERSION; ++v) {
+        const size_t size = odo_params_version_size((uint16_t)v);
+        fprintf(f, "%s{\"version\": %u, \"size\": %zu, \"crc_offset\": %zu}", v == 1U ? "" : ", ", v, size,
+                size - 4U);
+    }
+    fputs("],\n \"header\": [{\"name\": \"magic\", \"offset\": 0, \"width\": 4, \"type\": \"u32\"}, "
+          "{\"name\": \"version\", \"offset\": 4, \"width\": 2, \"type\": \"u16\"}, "
+          "{\"name\": \"length\", \"offset\": 6, \"width\": 2, \"type\": \"u16\"}],\n"
+          " \"checks\": [\"link.length_min_um < link.length_max_um\"],\n \"fields\": [", f);
+    const char *sep = "\n  ";
+    /* Straight from the X-macro: every column as written in odo_params.h. */
+#define LAYOUT_ROW(id, scope, member, json, since, off, stride, type, lo, hi, unit)                         \
+    do {                                                                                                  \
+        const odo_param_field_info_t *fi = odo_params_field_info(ODO_PF_##id);                              \
+        fprintf(f, "%s{\"id\": \"%s\", \"name\": \"%s\", \"scope\": \"%s\", \"member\": \"%s\", "                \
+                   "\"since\": %d, \"offsets\": [%d", sep, #id, json, scope_key(#scope), #member, since, off);   \
+        if (strcmp(#scope, "TRUCK") == 0) {                                                               \
+            for (unsigned t = 1U; t < ODO_TRUCKS; ++t) {                                                  \
+                fprintf(f, ", %d", (off) + (int)t * (stride));                                              \
+            }                                                                                             \
+        }                                                                                                 \
+        fprintf(f, "], \"width\": %u, \"type\": \"%s\", \"signed\": %s, \"min\": %" PRId64                \
+                   ", \"max\": %" PRId64 ", \"unit\": \"%s\", \"enum\": %u}",                                    \
+                fi->width, strcmp(#type, "I32") == 0 ? "i32" : strcmp(#type, "U32") == 0 ? "u32"            \
+                                                      : strcmp(#type, "U16") == 0 ? "u16" : "u8",           \
+                strcmp(#type, "I32") == 0 ? "true" : "false", (int64_t)(lo), (int64_t)(hi), unit,          \
+                (unsigned)ODO_PF_##id);                                                                   \
+        sep = ",\n  ";                                                                                    \
+    } while (0);
+    ODO_PARAMS_FIELDS(LAYOUT_ROW)
+#undef LAYOUT_ROW
+    fputs("]}\n", f);
+}
+
+static int cmd_layout(int argc, char **argv)
+{
+    const char *out = NULL;
+    for (int i = 0; i < argc; i++) {
+        if (is_help(argv[i])) {
+            usage_layout(stdout);
+            return 0;
+        }
+        if ((strcmp(argv[i], "--out") == 0 || strcmp(argv[i], "-o") == 0) && i + 1 < argc) {
+            out = argv[++i];
+        } else {
+            fprintf(stderr, "%s: layout: unexpected argument '%s'\n", k_prog, argv[i]);
+            usage_layout(stderr);
+            return EXIT_USAGE;
+        }
+    }
+    if (out == NULL) {
+        print_layout(stdout);
+        return fflush(stdout) == 0 ? 0 : EXIT_REJECTED;
+    }
+    char *text = NULL;
+    size_t len = 0;
+    FILE *m = open_memstream(&text, &len);
+    if (m == NULL) {
+        fprintf(stderr, "%s: out of memory\n", k_prog);
+        return EXIT_REJECTED;
+    }
+    print_layout(m);
+    if (fclose(m) != 0) {
+        free(text);
+        fprintf(stderr, "%s: out of memory\n", k_prog);
+        return EXIT_REJECTED;
+    }
+    const int rc = write_file_atomic(out, (const uint8_t *)text, len) == 0 ? 0 : EXIT_REJECTED;
+    free(text);
+    return rc;
+}
+
 int main(int argc, char **argv)
 {
     if (argc < 2) {
@@ -431,6 +438,9 @@ int main(int argc, char **argv)
     }
     if (strcmp(argv[1], "show") == 0) {
         return cmd_show(argc - 2, argv + 2);
+    }
+    if (strcmp(argv[1], "layout") == 0) {
+        return cmd_layout(argc - 2, argv + 2);
     }
     fprintf(stderr, "%s: unknown command '%s'\n", k_prog, argv[1]);
     usage_main(stderr);

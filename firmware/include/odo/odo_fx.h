@@ -48,6 +48,17 @@ bool odo_muldiv_u64(uint64_t a, uint64_t b, uint64_t d, uint64_t *out);
 /// cannot overflow as long as the true result fits in int64. Three 32x32 multiplies.
 int64_t odo_mul_s64_s32_shr(int64_t a, int32_t b, unsigned shift);
 
+/// round(a * b / 2^shift) for an unsigned 32-bit b, shift in [1, 62]; exact through a 96-bit
+/// product as odo_mul_s64_s32_shr, rounding half away from zero. Three 32x32 multiplies.
+int64_t odo_mul_s64_u32_shr(int64_t a, uint32_t b, unsigned shift);
+
+/// The fraction n / d in Q32: round(n * 2^32 / d) for n < d, which is at most 2^32 - 1, so it
+/// always fits; saturates to UINT32_MAX when n >= d (d == 0 included). Exact rounding (ties
+/// cannot occur: d < 2^32 has at most 31 factors of two). Two 32/32 divisions after
+/// normalising d (Knuth's algorithm D with 16-bit digits, as Hacker's Delight's divlu), so no
+/// 64-bit division: constant time apart from at most two corrections per digit.
+uint32_t odo_frac_q32(uint32_t n, uint32_t d);
+
 /// Arithmetic right shift of a signed value with rounding to nearest (shift in [1, 62]).
 int64_t odo_shr_round_s64(int64_t v, unsigned shift);
 

@@ -6,6 +6,25 @@
 /// distance per count in mm Q40, per-wheel heading per count in turns Q64. One tick costs two
 /// 64x64 multiplies for the heading, two for distance and two 64x32 for position; no loops.
 ///
+/// Tyre scrub (effect `scrub` of the effects catalog; parameter scrub_q30 per truck): real robots
+/// show a larger effective wheelbase on arcs than on spot turns (the OptiOdom runs: Eb ~1.0065
+/// on spot turns, ~1.0123 on circles of 0.37 m radius). This extends 000 Eq. 2.4 (with b_eff of
+/// Eq. 2.8) by a factor on the heading change only. Per tick, with dL, dR the accepted deltas
+/// (forward positive):
+///   v = |dL| + |dR|;  m = 2 min(|dL|, |dR|) if dL, dR have the same strict sign, else 0
+///   dtheta = dtheta(000 Eq. 2.4, with Ed, Eb, Es) * (1 - k m / v)      (v == 0: no motion)
+/// m / v = 1 - s, where s = |dR - dL| / v is the spin fraction (1 on a spot turn, 0 straight,
+/// b / 2R on an arc of radius R). So Eb keeps its meaning on spot turns (what UMBmark measures)
+/// and the effective wheelbase on an arc is b Eb / (1 - k (1 - s)); k > 0 lengthens it. The
+/// centre displacement (Eq. 2.3) is unchanged. k in Q30, |k| <= 1/4; k == 0 skips the term and
+/// gives bit for bit the plain Eq. 2.4. Cost when k != 0 and both wheels move the same way: two
+/// 64x32 modular multiplies for k dtheta, one odo_frac_q32 (two 32-bit divisions) and one 64x32
+/// multiply (x86-64: about 130 instructions per truck on an arc tick, a few on a spot turn;
+/// `odo-bench --json` prints scrub_step_instructions). Error: m / v is rounded to Q32 (within
+/// 2^-33, no ties) and then multiplies k dtheta, so the heading error per tick is below
+/// |k dtheta| 2^-33 (about 3e-11 rad per radian turned at |k| = 1/4) plus half a Q64 LSB per
+/// count from the rounded k-scaled multipliers (1.7e-19 turns per count).
+///
 /// Accuracy (tests/host/test_odometry_reference.c and odo-bench): against a double-precision
 /// reference fed the same counts, after 1 km of mixed driving the pose differs by <= 0.1 mm and
 /// <= 1e-6 rad.
@@ -26,8 +45,10 @@ extern "C" {
 typedef struct {
     int64_t  dist_mm_q40[2];  ///< distance per count, [ODO_LEFT, ODO_RIGHT]: cL/R * cm (Eq. 6.35)
     uint64_t turn_q64[2];     ///< heading change per count: dist / (2 pi b_eff) (Eq. 2.4), turns Q64
+    uint64_t scrub_turn_q64[2]; ///< k * turn_q64[w], two's complement (the scrub term's k dtheta)
+    int32_t  scrub_q30;       ///< k of the scrub term (odo_truck_params_t); 0: term skipped
     uint32_t max_counts;      ///< largest believable |delta| per tick (from max_wheel_speed_mm_s)
-    uint8_t  counter_bits;    ///< decoder counter width (16, 24, 32)
+    uint8_t  counter_bits;    ///< decoder counter width, ODO_COUNTER_BITS_MIN..ODO_COUNTER_BITS_MAX
     uint8_t  invert;          ///< ODO_TRUCK_INVERT_* flags
     uint8_t  heading_form;    ///< odo_heading_form_t
 } odo_model_t;
@@ -52,31 +73,44 @@ typedef enum {
     ODO_MODEL_ERR_RANGE,    ///< the parameters give multipliers that do not fit the number formats
 } odo_model_status_t;
 
+/// Counter widths a wheel decoder may have (odo_params_t.counter_bits; real decoders: 8 to 32).
+#define ODO_COUNTER_BITS_MIN 8U
+#define ODO_COUNTER_BITS_MAX 32U
+
 /// Precompute the multipliers for one truck (integer 128-bit arithmetic; a few microseconds).
 ///   cm     = pi * (Dn / Es) / counts_per_rev              (000 Eq. 2.1 with App. B: Dn* = Dn/Es)
 ///   cL, cR = 2 / (Ed + 1), 2 / (1/Ed + 1)                  (000 Eqs. 6.33, 6.34)
 ///   b_eff  = Eb * b_nominal                               (000 Eq. 6.28 via Eq. 2.8)
+///   k turn = k * turn per count                           (the scrub term above)
 /// Note on App. B: Eq. B.1 defines Es = L_calc/L_actual, so the diameter that makes L_calc equal
 /// L_actual is Dn/Es; the transcription's "Dn* = Es Dn" (B.2) contradicts B.1 and is not used.
-/// Returns ODO_MODEL_ERR_RANGE (and leaves *m untouched) if a multiplier would overflow its format
-/// or max_counts * distance exceeds 2^61 mm Q40; params must already pass odo_params_validate.
+/// Returns ODO_MODEL_ERR_RANGE (and leaves *m untouched) if counter_bits is outside [8, 32], |k|
+/// exceeds 1/4, a multiplier would overflow its format, max_counts * distance exceeds 2^61 mm
+/// Q40, or max_counts reaches half the counter range (the modular delta would be ambiguous: an
+/// 8-bit counter allows at most 127 counts per tick); params must already pass odo_params_validate.
 odo_model_status_t odo_model_init(odo_model_t *m, const odo_truck_params_t *tp, uint8_t counter_bits,
                                   uint8_t heading_form, uint32_t tick_us,
                                   uint32_t max_wheel_speed_mm_s);
 
 /// Signed difference cur - prev of two raw counter readings modulo 2^bits (bits in [1, 32]),
-/// interpreted in [-2^(bits-1), 2^(bits-1)). Handles every wrap of a 16, 24 or 32-bit counter.
+/// interpreted in [-2^(bits-1), 2^(bits-1)). Handles every wrap of any counter width.
 int32_t odo_count_delta(uint32_t prev, uint32_t cur, uint8_t bits);
 
 /// Reset a truck to a pose; the next reading sets the counter baseline.
 void odo_truck_reset(odo_truck_t *t, const odo_pose_t *pose);
 
-/// One dead-reckoning step from raw counter readings (000 Eqs. 2.2-2.6).
+/// One dead-reckoning step from raw counter readings (000 Eqs. 2.2-2.6, with the scrub term).
 /// `bits` is the width the readings carry (a CAN frame carries 24); the modulus used is
 /// 2^min(bits, model counter_bits). On a jump (|delta| > max_counts on either wheel) the pose is
 /// not changed, the baseline is re-taken, and out->jump is true. Never fails otherwise.
 void odo_truck_step(odo_truck_t *t, const odo_model_t *m, uint32_t left_raw, uint32_t right_raw,
                     uint8_t bits, odo_step_t *out);
+
+/// The tyre-scrub part of one tick's heading change, k dtheta m / v in signed turns Q64 (the term
+/// above; odo_truck_step subtracts it when k != 0), for accepted deltas (|d| <= max_counts).
+/// 0 unless both wheels moved the same strict way. Constant time: two 32-bit divisions at most.
+/// A function of its own so the k == 0 path of odo_truck_step carries none of its code.
+int64_t odo_scrub_dturn(const odo_model_t *m, int32_t d_left, int32_t d_right);
 
 /// Advance a pose by a centre displacement and heading change (000 Eqs. 2.5, 2.6), with the
 /// midpoint or the paper's heading form. Shared by odometry and IPEC re-integration.

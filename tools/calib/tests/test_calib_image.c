@@ -1,6 +1,7 @@
 /// Firmware image formats (tools/calib/image.h): a block found by magic in a raw image among
 /// decoys, an Intel HEX whose records straddle the block, and every refusal the issue lists
-/// (wrong layout or version, truncated, malformed), with the original left untouched.
+/// (wrong layout or version, truncated, malformed, a version-1 image), with the original left
+/// untouched.
 #include <check.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -63,7 +64,8 @@ START_TEST(raw_image_block_is_found_among_decoys_and_patched_in_place)
     ck_assert_uint_eq(get(out, back, sizeof back), sizeof img);
     ck_assert_mem_eq(back, img, 0x4000);
     ck_assert_mem_eq(back + 0x4000, nb, ODO_PARAMS_SIZE);
-    ck_assert_mem_eq(back + 0x4080, img + 0x4080, sizeof img - 0x4080);
+    ck_assert_mem_eq(back + 0x4000 + ODO_PARAMS_SIZE, img + 0x4000 + ODO_PARAMS_SIZE,
+                     sizeof img - 0x4000 - ODO_PARAMS_SIZE);
     ck_assert_uint_eq(get(path, back, sizeof back), sizeof img); /* original untouched */
     ck_assert_mem_eq(back, img, sizeof img);
 }
@@ -80,14 +82,14 @@ START_TEST(raw_image_refusals_name_the_problem)
     path_in(path, sizeof path, "bad.bin");
     img_t m;
 
-    img[0x104] = 2; /* version 2, CRC recomputed: another layout */
+    img[0x104] = 3; /* version 3, CRC recomputed: another layout */
     const uint32_t crc = odo_crc32(img + 0x100, ODO_PARAMS_CRC_OFFSET);
     for (int k = 0; k < 4; ++k) {
         img[0x100 + ODO_PARAMS_CRC_OFFSET + k] = (uint8_t)(crc >> (8 * k));
     }
     put(path, img, sizeof img);
     ck_assert_int_eq(img_load(path, &m, err, sizeof err), -1);
-    ck_assert_msg(strstr(err, "version 2") != NULL, "%s", err);
+    ck_assert_msg(strstr(err, "version 3") != NULL && strstr(err, "versions 1 (128 bytes) and 2") != NULL, "%s", err);
 
     block_with(img + 0x100, 1 << 30);
     put(path, img, 0x100 + 60); /* truncated in the middle of the block */
@@ -177,6 +179,75 @@ START_TEST(intel_hex_records_straddling_the_block_are_patched_with_new_checksums
 }
 END_TEST
 
+/// A version-1 block (128 bytes) as firmware before version 2 carried it: bytes [0, 124) of a
+/// version-2 block, relabelled, with its CRC at 124 (odo_params.h).
+static void v1_block_with(uint8_t b[ODO_PARAMS_V1_SIZE], int32_t ed_q30)
+{
+    uint8_t v2[ODO_PARAMS_SIZE];
+    block_with(v2, ed_q30);
+    memcpy(b, v2, 124);
+    b[4] = 1;
+    b[6] = 128;
+    b[7] = 0;
+    const uint32_t crc = odo_crc32(b, 124);
+    for (int k = 0; k < 4; ++k) {
+        b[124 + k] = (uint8_t)(crc >> (8 * k));
+    }
+}
+
+/// An image built before version 2 (a raw .bin and an Intel HEX with a 128-byte block) still
+/// reads, as version 1, but writing a version-2 block into it is refused and leaves nothing: its
+/// firmware cannot read version 2, and the bytes after its block are not the block's.
+START_TEST(version_1_images_read_but_are_never_written)
+{
+    static uint8_t img[0x4100];
+    for (size_t i = 0; i < sizeof img; ++i) {
+        img[i] = (uint8_t)(i * 13U);
+    }
+    v1_block_with(img + 0x4000, (int32_t)(1.002 * (1 << 30)));
+    char path[256], out[256], err[512];
+    path_in(path, sizeof path, "v1.bin");
+    path_in(out, sizeof out, "v1-new.bin");
+    put(path, img, sizeof img);
+    img_t m;
+    ck_assert_msg(img_load(path, &m, err, sizeof err) == 0, "%s", err);
+    ck_assert_uint_eq(m.block_addr, 0x4000);
+    ck_assert_uint_eq(m.version, 1);
+    ck_assert_uint_eq(m.block_len, ODO_PARAMS_V1_SIZE);
+    ck_assert_int_eq(m.status, ODO_PARAMS_OK);
+    uint8_t nb[ODO_PARAMS_SIZE];
+    block_with(nb, 1 << 30);
+    ck_assert_int_eq(img_write_patched(&m, nb, out, err, sizeof err), -1);
+    ck_assert_msg(strstr(err, "version-1 parameter block (128 bytes)") != NULL, "%s", err);
+    img_free(&m);
+    ck_assert_int_eq(access(out, F_OK), -1);
+    static uint8_t back[sizeof img];
+    ck_assert_uint_eq(get(path, back, sizeof back), sizeof img);
+    ck_assert_mem_eq(back, img, sizeof img);
+
+    /* A version-1 block cut off before its 128 bytes is truncated, not another layout. */
+    put(path, img, 0x4000 + 100);
+    ck_assert_int_eq(img_load(path, &m, err, sizeof err), -1);
+    ck_assert_msg(strstr(err, "truncated") != NULL, "%s", err);
+
+    /* The same block in an Intel HEX. */
+    path_in(path, sizeof path, "v1.hex");
+    FILE *f = fopen(path, "wb");
+    const uint8_t ela[2] = {0x08, 0x00};
+    hex_rec(f, 4, 0, ela, 2);
+    for (unsigned off = 0; off < 0x100; off += 16) {
+        hex_rec(f, 0, 0x4000 + off, img + 0x4000 + off, 16);
+    }
+    hex_rec(f, 1, 0, NULL, 0);
+    fclose(f);
+    ck_assert_msg(img_load(path, &m, err, sizeof err) == 0, "%s", err);
+    ck_assert_uint_eq(m.version, 1);
+    ck_assert_uint_eq(m.block_addr, 0x08004000);
+    ck_assert_int_eq(img_write_patched(&m, nb, out, err, sizeof err), -1);
+    img_free(&m);
+}
+END_TEST
+
 int main(void)
 {
     if (mkdtemp(g_dir) == NULL) {
@@ -187,6 +258,7 @@ int main(void)
     tcase_add_test(tc, raw_image_block_is_found_among_decoys_and_patched_in_place);
     tcase_add_test(tc, raw_image_refusals_name_the_problem);
     tcase_add_test(tc, intel_hex_records_straddling_the_block_are_patched_with_new_checksums);
+    tcase_add_test(tc, version_1_images_read_but_are_never_written);
     suite_add_tcase(s, tc);
     const int rc = ts_run_suite(s);
     char cmd[300];
