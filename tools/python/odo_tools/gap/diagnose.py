@@ -387,11 +387,19 @@ class Judgement:
 
 def judge(ds: Dataset, sel: Selection, rk: Ranking) -> Judgement:
     """Step 3: background under the best candidate, held-out gap, verdict."""
+    items, fit_items = ds.items, rk.prob.items
+    if ds.mode == "truth" and ds.instrument is not None:
+        apply(rk.best, ds.prs)
+        ds.instrument = instrument.under(ds.instrument, ds.prs, rk.best.model_params())
+        clear_bumps(ds.prs)
+        items = [TruthMode(pr, ds.robot, ds.instrument) for pr in ds.prs]
+        fit_items = [items[i] for i in sel.fit]
+        ds.items = items
     fprs = [ds.prs[i] for i in sel.fit]
     apply(rk.best, fprs)
-    bg = measure(rk.prob.items, rk.prob.sigma, ds.mode, rk.best.model_params())
+    bg = measure(fit_items, rk.prob.sigma, ds.mode, rk.best.model_params())
     clear_bumps(fprs)
-    held = evaluate_heldout(ds.items, ds.prs, list(sel.held), rk.best, rk.prob.sigma, bg)
+    held = evaluate_heldout(items, ds.prs, list(sel.held), rk.best, rk.prob.sigma, bg)
     dbic = rk.null.bic - rk.best.bic
     verdict, reason = decide(held, dbic, rk.best.label)
     return Judgement(verdict, reason, bg, held, dbic)

@@ -98,7 +98,7 @@ class Problem:
     def walk_k(self, P: dict) -> int:
         """Parameters the measured walk costs a hypothesis (none for roughness, which brings its
         own variance)."""
-        if self.walk is None or not any(q > 0 for q in getattr(self.walk, "q_wheel", [])):
+        if self.walk is None or not self.walk.active:
             return 0
         return 0 if P.get("roughness.max_height_mm", 0.0) > 0 else 1
 

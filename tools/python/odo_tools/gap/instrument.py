@@ -58,6 +58,18 @@ def estimate(prs: list[Prepared], trucks: int) -> tuple[Instrument, list[str]]:
     return inst, notes
 
 
+def under(inst: Instrument, prs: list[Prepared], P: dict) -> Instrument:
+    """The instrument with each run's latency estimated again under a candidate P, without the
+    half-tick floor: once the candidate takes its own share of the heading misfit where the rate
+    changes (slip does; a kinematic effect does not), what is left of a shift is the clock. The
+    OptiOdom squares' ~25 ms, half their 50 ms tick, read as the truth's noise otherwise."""
+    out = Instrument(list(inst.lever_mm), list(inst.lever_se_mm), dict(inst.latency_s))
+    for pr in prs:
+        if pr.run.truth is not None:
+            out.latency_s[pr.run.name] = latency(pr, 0, P, min_tick=0.0)
+    return out
+
+
 def _windows(tt: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     dt = float(np.median(np.diff(tt)))
     W = max(1, round(WINDOW_S / dt))
@@ -69,11 +81,12 @@ def _mad(x: np.ndarray) -> float:
     return float(1.4826 * np.median(np.abs(x - np.median(x)))) if x.size else 0.0
 
 
-def latency(pr: Prepared, truck: int = 0) -> float:
-    """The shift (s) that best lines the truth's heading increments up with the nominal model's,
-    or 0 when no shift helps beyond chance."""
+def latency(pr: Prepared, truck: int = 0, P: dict | None = None, min_tick: float = 0.5) -> float:
+    """The shift (s) that best lines the truth's heading increments up with the model's (P,
+    nominal by default), or 0 when no shift helps beyond chance or it is shorter than
+    `min_tick` count ticks."""
     tr = pr.run.truth
-    th_m = dead_reckon(pr, {}, truck)[:, 2]
+    th_m = dead_reckon(pr, P or {}, truck)[:, 2]
     tt, th_t = tr.t_s, tr.pose[:, truck, 2]
     i, j = _windows(tt)
     if i.size < 10:
@@ -104,7 +117,7 @@ def latency(pr: Prepared, truck: int = 0) -> float:
     # a shift shorter than half a count tick is inside the counts' own timing, and an effect
     # that acts where the heading rate changes (slip on a turn's start, a motor lag) shifts
     # the heading like it: the blind check's slip read as 13 ms of latency and lost its law
-    if abs(L) < 0.5 * float(np.median(pr.dt)):
+    if abs(L) < min_tick * float(np.median(pr.dt)):
         return 0.0
     if 0 < k < grid.size - 1:  # parabola through the three best
         c0, c1, c2 = cost[k - 1], cost[k], cost[k + 1]

@@ -91,6 +91,11 @@ def to_centre(pose: np.ndarray, lever_mm: list[tuple[float, float]]) -> np.ndarr
     return out
 
 
+def spot_ticks(pr: Prepared) -> np.ndarray:
+    """(n-1, trucks): ticks whose wheels roll opposite ways (a turn on the spot)."""
+    return (pr.ds[:, :, 0] * pr.ds[:, :, 1]) < 0.0
+
+
 def _grain_count_cv2(P: dict) -> float:
     """Squared coefficient of variation of the grain count: gaps spacing * (1 + jitter U(-1, 1))
     make a renewal count of variance n cv^2, cv^2 = jitter^2 / 3."""
@@ -167,6 +172,19 @@ class TruthMode:
                 for t in range(self.trucks)
             ]
         )  # (trucks, 2, nwin)
+        # the part of it (both wheels summed) turned on the spot: the background walks at its
+        # own rate there (background.py: the OptiOdom robot's walk lives on its spot turns)
+        spot = spot_ticks(pr)  # (n-1, trucks)
+        St = np.concatenate(
+            [np.zeros((1, pr.ds.shape[1])), np.cumsum(np.abs(pr.ds).sum(axis=2) * spot, axis=0)]
+        )
+        self.wturn = np.stack(
+            [
+                np.interp(self.tt[self.j], pr.t, St[:, t])
+                - np.interp(self.tt[self.i], pr.t, St[:, t])
+                for t in range(self.trucks)
+            ]
+        )  # (trucks, nwin)
 
     def model_pose(self, P: dict, truck: int) -> np.ndarray:
         p = dead_reckon(self.pr, P, truck)

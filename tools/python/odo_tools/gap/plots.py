@@ -132,7 +132,9 @@ def _background_track(rep: dict, it: TruthMode, k: int, ctx: Context):
     q = rep["background"].get("walk_q_wheel_mm2_per_mm")
     if q is None:
         return None
-    bg = Background("truth", list(q))
+    b = rep["background"]
+    bg = Background("truth", list(q), list(b.get("walk_q_turn_mm2_per_mm", q)))
+    bg.q_long = list(b.get("walk_q_long_mm2_per_mm", []))
     tv = bg.track_var(it, 0)
     s = rep["noise_sigma"]["A.longitudinal_mm"] / np.sqrt(2.0)
     allow = 2.0 * np.sqrt(tv[:, 0] + tv[:, 1] + 2 * s * s)

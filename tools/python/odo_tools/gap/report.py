@@ -12,7 +12,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from . import catalog
-from .background import heading_walk_deg_per_sqrt_m
+from .background import heading_walk_deg_per_sqrt_m, spot_turn_deg
 from .fit import DBIC_PAIR, DBIC_SIGNIFICANT, Z_GAP
 from .stability import STABLE_Z
 from .verdict import THRESHOLDS
@@ -172,8 +172,14 @@ class Report:
         if bg.q_wheel:
             bgd["walk_q_wheel_mm2_per_mm"] = bg.q_wheel
             bgd["walk_q_wheel_68ci"] = [list(x) for x in bg.q_wheel_ci]
+            bgd["walk_q_turn_mm2_per_mm"] = bg.q_turn
+            bgd["walk_q_turn_68ci"] = [list(x) for x in bg.q_turn_ci]
+            bgd["walk_q_long_mm2_per_mm"] = bg.q_long
             bgd["heading_walk_deg_per_m"] = [
                 heading_walk_deg_per_sqrt_m(q, ds.prs[0].b[t]) for t, q in enumerate(bg.q_wheel)
+            ]
+            bgd["heading_per_spot_turn_deg"] = [
+                spot_turn_deg(q, ds.prs[0].b[t]) for t, q in enumerate(bg.q_turn)
             ]
         if bg.spread is not None:
             bgd["return_spread"] = dict(zip(chans, map(float, bg.spread), strict=False))
@@ -550,9 +556,11 @@ def _remainder(rep: dict) -> str:
     parts = []
     if "heading_walk_deg_per_m" in bg:
         w = bg["heading_walk_deg_per_m"][0]
+        s = bg["heading_per_spot_turn_deg"][0]
         parts.append(
-            f"a heading random walk of {w:.2f} deg per sqrt(m) of travel (floor and wheels, "
-            "measured under the candidate) and the truth's own noise"
+            f"a heading random walk of {w:.2f} deg per sqrt(m) of travel and {s:.2f} deg (one "
+            "sigma) per 90 deg turn on the spot, different on every run (floor and wheels, "
+            "measured under the candidate), and the truth's own noise"
         )
     if "return_spread" in bg:
         s = bg["return_spread"]

@@ -21,6 +21,10 @@ from .paths import turn_style
 
 STABLE_Z = 3.0
 ALWAYS = ("ed.value", "eb.value")  # the calibration a user would carry between sessions
+# the verdict's parameters compared across groups: those of a robot's geometry and sensors.
+# Floor and drive laws (slip, skid, count loss, bumps, roughness) are not: each group's refit
+# costs a full fit of a law that depends on the paths each group drove.
+COMPARED = ("ed", "eb", "es", "scrub", "rotary_bias", "link_bias")
 
 
 @dataclass
@@ -84,7 +88,7 @@ def analyse(
     # (a) the calibration a user would carry (Ed, Eb), every other effect at nominal: a wheelbase
     #     that moves with the way the robot turns shows here; (b) the verdict's own parameters
     sets = [("calibration", kin)]
-    vkeys = [k for k in base if not k.startswith("bumps.")]
+    vkeys = [k for k in base if k.split(".")[0] in COMPARED]
     if vkeys and set(vkeys) != set(kin):
         sets.append(("verdict", vkeys))
     kinds = _kinds(prs, groups, mode)

@@ -367,11 +367,11 @@ def world(name: str):
 def _diag(job: tuple) -> dict:
     real, mode = job
     from ..gap.diagnose import diagnose
-    from ..gap.report import write_report
 
     try:
+        # the case's data (and any report beside them) are deleted after scoring: the worker
+        # returns the report's content and writes no files
         rep = diagnose(real, Path(real) / "robot.json", 0.5, 1, mode)
-        write_report(rep, Path(real).parent / f"report-{mode}")
         rep.context = None
         return {"real": real, "mode": mode, "report": rep.to_dict()}
     except GapInputError as e:
