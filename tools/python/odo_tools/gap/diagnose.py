@@ -61,7 +61,10 @@ BUMPS_REUSE_WITH = {"ed", "skid", "rotary_bias", "link_bias", "scrub"}
 # effect's systematic misfit, so it is paired with the best others instead of taking their place
 ABSORBERS = {"roughness"}
 N_PAIR_BASE = 4
-N_THIRD = 5
+N_THIRD = 4
+# a third member is one of the robot's geometry (Ed, Eb, Es and a scrub come together on a real
+# robot: the OptiOdom wheelbase needs both Eb and a scrub), never a floor or drive law
+THIRDS = ("ed", "eb", "es", "scrub")
 
 
 @dataclass
@@ -231,7 +234,10 @@ def rank(ds: Dataset, sel: Selection, progress: Progress = None) -> Ranking:
     cands = list(singles)
     gof = prob.gof_z({})
     best = singles[0]
-    if null.bic - best.bic >= DBIC_SIGNIFICANT or (gof is not None and gof >= Z_GAP):
+    gap = null.bic - best.bic >= DBIC_SIGNIFICANT or (gof is not None and gof >= Z_GAP)
+    # pairs, unless the best single already leaves nothing but background on the fitting runs'
+    # tracks (truth mode): most robots have one effect, and ten pair fits cost more than the rest
+    if gap and not (ds.mode == "truth" and _track_ratio(best, prob, ds, sel) <= R_WITHIN):
         cands += _pairs(singles, prob, fprs, sig_head, progress)
     cands.sort(key=lambda f: f.bic)
     c_hat = max(1.0, best.chi / max(prob.e0 - best.k, 1))
@@ -355,13 +361,11 @@ def _pairs(singles, prob, fprs, sig_head, progress) -> list[Fit]:
 
 def _third(pair: Fit, singles, prob, fprs, sig_head, progress) -> list[Fit]:
     """A third member for an accepted pair (the kinematic calibration of a real robot is often
-    three: Ed, Eb and a scrub), from the best singles of other families."""
+    three: Ed, Eb and a scrub), from the best kinematic singles of other families."""
     out = []
     n = 0
     for f in singles:
-        if set(f.hyp.families) & set(pair.hyp.families) or f.hyp.has_bumps:
-            continue
-        if f.hyp.families[0] in ABSORBERS:
+        if set(f.hyp.families) & set(pair.hyp.families) or f.hyp.families[0] not in THIRDS:
             continue
         h = pair.hyp + f.hyp
         if progress:

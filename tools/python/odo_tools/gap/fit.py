@@ -249,7 +249,9 @@ def fit_params(
         )
     for s0 in starts:
         s0 = np.clip(s0, np.array(lo) + 1e-12, np.array(hi) - 1e-12)
-        res = least_squares(f, s0, bounds=(lo, hi), x_scale="jac", max_nfev=60)
+        res = least_squares(
+            f, s0, bounds=(lo, hi), x_scale="jac", max_nfev=60, ftol=1e-6, xtol=1e-6, gtol=1e-6
+        )
         if best is None or res.cost < best.cost:
             best = res
     P = dict(base)

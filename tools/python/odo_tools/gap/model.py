@@ -345,20 +345,26 @@ def _slip_substep_terms(pr: Prepared, truck: int, tau: float, a0: float):
     sel = np.flatnonzero((a_first > a0).ravel())
     res = None
     if sel.size:
-        # the acceleration decays by q = 1 - g per sub-step: beyond J sub-steps none exceeds a0
-        J = M
-        amax = float(a_first.ravel()[sel].max())
+        # the acceleration decays by q = 1 - g per sub-step: tick i slips for its first J_i
+        # sub-steps only (ragged: a tick barely over a0 costs one sub-step, not M)
+        q = 1.0 - g
+        af = a_first.ravel()[sel]
         if a0 > 0.0:
-            J = int(min(M, 1 + math.ceil(math.log(a0 / amax) / math.log(1.0 - g))))
-        cs, ms = c.ravel()[sel][:, None], m0.ravel()[sel][:, None]
-        qj = (1.0 - g) ** np.arange(J + 1)  # sub-step j = 0 is the tick's start
-        vm = cs + (ms - cs) * qj  # speed after each sub-step
-        acc = np.abs(np.diff(vm, axis=1)) / SLIP_SUB_S * 1e-3  # m/s^2
-        ex = acc - a0
+            J = np.minimum(M, 1 + np.ceil(np.log(a0 / af) / math.log(q))).astype(np.int64)
+        else:
+            J = np.full(sel.size, M, dtype=np.int64)
+        J = np.maximum(J, 1)
+        rows = np.repeat(sel, J)
+        starts = np.repeat(np.cumsum(J) - J, J)
+        j = np.arange(rows.size) - starts + 1  # sub-step 1..J_i
+        cs, ms = c.ravel()[rows], m0.ravel()[rows]
+        qj = q ** j.astype(float)
+        v1 = cs + (ms - cs) * qj  # speed after sub-step j
+        v0 = cs + (ms - cs) * qj / q  # and before it
+        ex = np.abs(v1 - v0) / SLIP_SUB_S * 1e-3 - a0
         keep = ex > 0.0
-        up = np.abs(vm[:, 1:]) >= np.abs(vm[:, :-1])
-        rows = np.broadcast_to(sel[:, None], ex.shape)
-        res = (rows[keep], ex[keep], (vm[:, 1:] * SLIP_SUB_S)[keep], up[keep])
+        up = np.abs(v1) >= np.abs(v0)
+        res = (rows[keep], ex[keep], (v1 * SLIP_SUB_S)[keep], up[keep])
     _cache_put(pr.slip_cache, key, res)
     return res
 
@@ -388,12 +394,17 @@ def integrate(
     return np.column_stack([x, y, th])
 
 
+# effects on the linkage encoders' readings only: the trucks' tracks do not depend on them, so a
+# fit of them reuses the cached tracks instead of dead-reckoning again for every step
+SENSOR_ONLY = ("rotary_bias.", "link_bias.")
+
+
 def _track(pr: Prepared, P: dict, truck: int) -> np.ndarray:
     """One truck's dead-reckoned track from the origin under P (cached per run: a clapper's
     clamp needs both trucks for each, and fits ask for each truck in turn)."""
     key = (
         truck,
-        tuple(sorted(P.items())),
+        tuple(sorted((k, v) for k, v in P.items() if not k.startswith(SENSOR_ONLY))),
         tuple((b["truck"], b["wheel"], b["s0"], b["h"]) for b in pr.bumps),
     )
     hit = pr.track_cache.get(key)
