@@ -172,7 +172,9 @@ def _multiscale(per_run: list[tuple[np.ndarray, np.ndarray]]) -> tuple[float, fl
     if len(xs) < 2:
         return (ys[0] if ys else 0.0), 0.0
     x, y, w = (np.asarray(v, dtype=float) for v in (xs, ys, ws))
-    w = w / np.maximum(y, 1e-300) ** 2  # a variance estimate's own variance grows as its square
+    if not np.any(y > 0):  # a noiseless truth (odo-sim's own files): nothing walks
+        return 0.0, 0.0
+    w = w / np.maximum(y, 1e-12 * y.max()) ** 2  # a variance estimate's variance: its square
     A = np.column_stack([np.ones_like(x), x]) * np.sqrt(w)[:, None]
     coef = np.linalg.lstsq(A, y * np.sqrt(w), rcond=None)[0]
     if coef[1] < 0:  # no walk: the intercept is the mean level
@@ -202,8 +204,9 @@ def walk_by_phase(per_run: list[tuple[np.ndarray, np.ndarray]], b: float) -> tup
             rows_e.append(e)
     d2 = np.concatenate(rows_d) ** 2
     E = np.vstack(rows_e) / b**2
-    if d2.size < 16:
+    if d2.size < 16 or not np.median(d2) > 0:
         return 0.0, 0.0
+    tiny = 1e-9 * float(np.median(d2))
     has_turn = np.sum(E[:, 1] > 0) >= 8
     X = (
         np.column_stack([np.ones_like(d2), E[:, 0], E[:, 1]])
@@ -214,13 +217,13 @@ def walk_by_phase(per_run: list[tuple[np.ndarray, np.ndarray]], b: float) -> tup
     coef[0] = float(np.median(d2)) / 0.455
     keep = np.ones(d2.size, dtype=bool)
     for _ in range(8):
-        fit = np.maximum(X @ coef, 1e-300)
+        fit = np.maximum(X @ coef, tiny)
         keep = d2 <= 9.0 * fit
         w = 1.0 / fit
         Xw = X[keep] * w[keep, None]
         coef = np.linalg.lstsq(Xw, d2[keep] * w[keep], rcond=None)[0]
         coef[1:] = np.maximum(coef[1:], 0.0)
-        coef[0] = max(coef[0], 1e-300)
+        coef[0] = max(coef[0], tiny)
     if not has_turn:  # the columns are travel / b^2: the slopes are q_wheel itself
         return float(coef[1]), float(coef[1])
     return float(coef[1]), float(coef[2])
