@@ -68,6 +68,9 @@ def plot_gap_along_path(rep: dict, ctx: Context, path: Path) -> None:
     distance travelled, nominal vs with the verdict's effect, the background allowance as a
     band, the phases along the bottom and the located bumps."""
     items, prs = ctx.items, ctx.prs
+    if rep["mode"] == "returns":
+        plot_return_errors(rep, ctx, path)
+        return
     held = list(ctx.held)[:4] or list(range(min(4, len(items))))
     fig, axs = plt.subplots(len(held), 1, figsize=(8.5, 2.5 * len(held) + 0.4), squeeze=False)
     name = ctx.fit.name if ctx.fit is not None else None
@@ -110,6 +113,50 @@ def plot_gap_along_path(rep: dict, ctx: Context, path: Path) -> None:
         ax.legend(ncol=4, loc="upper left", framealpha=0.8)
     truth = isinstance(items[0], TruthMode)
     axs[-1, 0].set_xlabel("distance travelled (m)" if truth else "row")
+    fig.tight_layout()
+    fig.savefig(path, dpi=DPI)
+    plt.close(fig)
+
+
+def plot_return_errors(rep: dict, ctx: Context, path: Path) -> None:
+    """Returns mode: each run's return position error (000 Eq. 3.1: true minus model) with the
+    nominal model and with the verdict's effect; held-out runs filled, fitted runs hollow; the
+    runs' own spread (the background) as a circle."""
+    items, prs = ctx.items, ctx.prs
+    P = apply(ctx.fit, prs) if ctx.fit is not None else {}
+    r0 = np.vstack([it.residuals({}) for it in items])
+    r1 = np.vstack([it.residuals(P) for it in items])
+    clear_bumps(prs)
+    held = set(ctx.held)
+    fig, ax = plt.subplots(figsize=(7.5, 6.5))
+    for k, pr in enumerate(prs):
+        ho = k in held
+        kw = {"s": 45 if ho else 30, "zorder": 3}
+        ax.scatter(r0[k, 0], r0[k, 1], c="k" if ho else "none", edgecolors="k", marker="s", **kw)
+        ax.scatter(r1[k, 0], r1[k, 1], c="C2" if ho else "none", edgecolors="C2", marker="o", **kw)
+        ax.plot([r0[k, 0], r1[k, 0]], [r0[k, 1], r1[k, 1]], color="0.7", lw=0.6, zorder=1)
+        if ho:
+            ax.annotate(
+                pr.run.name,
+                (r0[k, 0], r0[k, 1]),
+                fontsize=8,
+                xytext=(4, 4),
+                textcoords="offset points",
+            )
+    sp = rep["background"].get("return_spread", {})
+    if sp:
+        rad = float(np.hypot(sp.get("x_mm", 0.0), sp.get("y_mm", 0.0)))
+        ax.add_patch(plt.Circle((0, 0), rad, color="C1", alpha=0.2, label="background (spread)"))
+    ax.scatter([], [], c="k", marker="s", label="nominal model (filled: held out)")
+    name = ctx.fit.name if ctx.fit is not None else "nominal"
+    ax.scatter([], [], c="C2", marker="o", label=f"with {name} (filled: held out)")
+    ax.axhline(0, color="0.5", lw=0.6)
+    ax.axvline(0, color="0.5", lw=0.6)
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.set_xlabel("return error x (mm, true minus model)")
+    ax.set_ylabel("return error y (mm)")
+    ax.set_title(f"Return errors per run - verdict: {rep['verdict']['effect']}")
+    ax.legend(loc="best")
     fig.tight_layout()
     fig.savefig(path, dpi=DPI)
     plt.close(fig)
