@@ -123,7 +123,9 @@ def analyse(
                     z = abs(va - vb) / max(math.hypot(sa, sb), 1e-12)
                     if z < STABLE_Z:
                         continue
-                    if any(f.param == k and f.kind == kind for f in findings):
+                    if any(
+                        f.param == k and parts[f.kind] == parts[kind] for f in findings
+                    ):  # one finding per way of splitting the runs, whatever names it
                         continue
                     same = [o for o in kinds if o != kind and parts[o] == parts[kind]]
                     fd = Finding(
