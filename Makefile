@@ -4,7 +4,7 @@ SHELL := /bin/bash
 .DEFAULT_GOAL := help
 JOBS ?= $(shell nproc)
 
-.PHONY: help deps build release cm4 test demo bench clean
+.PHONY: help deps build release cm4 test demo bench soak clean
 
 help: ## list targets
 	@grep -E '^[a-z0-9-]+:.*## ' $(MAKEFILE_LIST) | awk -F':.*## ' '{printf "  make %-8s %s\n", $$1, $$2}'
@@ -32,6 +32,9 @@ demo: build ## run the main job on built-in sample data
 
 bench: release ## print benchmark figures as JSON (-O2 build: build/release/bin/odo-bench --json)
 	@build/release/bin/odo-bench --json
+
+soak: release ## frame loss at speed and the 24 h fault soak, JSON (build/release/bin/odo-soak --json)
+	@build/release/bin/odo-soak --json
 
 clean: ## remove build output (keeps .venv)
 	rm -rf build

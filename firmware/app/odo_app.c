@@ -63,30 +63,53 @@ odo_params_status_t odo_app_init(odo_app_t *app, const uint8_t *block, size_t le
     return st;
 }
 
+/// Count each raised fault bit; a clean tick (faults == 0) costs one test.
 static void count_faults(odo_fault_counters_t *c, uint32_t faults)
 {
-    for (unsigned b = 0U; b < ODO_FAULT_COUNT; ++b) {
-        if ((faults & (1UL << b)) != 0U && c->count[b] != UINT32_MAX) {
+    for (unsigned b = 0U; faults != 0U && b < ODO_FAULT_COUNT; ++b, faults >>= 1) {
+        if ((faults & 1U) != 0U && c->count[b] != UINT32_MAX) {
             c->count[b]++;
         }
     }
 }
 
-/// Sequence check of a truck's wheel frames: a repeat is a duplicate, a skip is lost frames.
-/// Counters are cumulative, so integrating after a gap is still exact (only resolution is lost).
-static uint32_t check_seq(odo_app_t *app, uint8_t truck, uint8_t seq)
+/// round(dt_us / tick_us) for dt_us < 2^32: one 32-bit division (a single UDIV on a Cortex-M4).
+static uint32_t ticks_in(uint32_t dt_us, uint32_t tick_us)
+{
+    const uint32_t q = dt_us / tick_us;
+    const uint32_t r = dt_us - q * tick_us;
+    return q + (r >= tick_us - r ? 1U : 0U);
+}
+
+/// Sequence check of a truck's wheel sample, and the ticks elapsed since its previous one (see
+/// odo_app_step): a repeat is a duplicate, a skip is lost frames. Counters are cumulative, so
+/// the sample is integrated over the whole gap.
+static uint32_t check_seq(odo_app_t *app, uint8_t truck, uint8_t seq, uint64_t t_us, uint32_t *ticks)
 {
     uint32_t f = 0U;
+    uint32_t n = 1U;
     if (app->seen_seq[truck]) {
         const uint8_t step = (uint8_t)(seq - app->last_seq[truck]);
         if (step == 0U) {
             f |= ODO_FAULT_SEQ_DUP;
-        } else if (step != 1U) {
-            f |= ODO_FAULT_SEQ_GAP;
+        } else {
+            if (step != 1U) {
+                f |= ODO_FAULT_SEQ_GAP;
+            }
+            n = step < 128U ? step : 256U - step; /* older than the last sample: its distance back */
+        }
+        /* The sequence number wraps at 256: from 128 ticks on, the clock counts them. */
+        const uint64_t last = app->last_wheel_t_us[truck];
+        const uint32_t tick_us = app->params.tick_us;
+        if (t_us >= last && t_us - last >= ((uint64_t)tick_us << 7)) {
+            const uint64_t dt = t_us - last;
+            n = dt > UINT32_MAX ? UINT32_MAX : ticks_in((uint32_t)dt, tick_us);
         }
     }
     app->seen_seq[truck] = true;
     app->last_seq[truck] = seq;
+    app->last_wheel_t_us[truck] = t_us;
+    *ticks = n;
     return f;
 }
 
@@ -94,23 +117,25 @@ static const uint32_t FAULT_MISSING[ODO_TRUCKS] = {ODO_FAULT_WHEEL_MISSING_A, OD
 static const uint32_t FAULT_JUMP[ODO_TRUCKS] = {ODO_FAULT_COUNTER_JUMP_A, ODO_FAULT_COUNTER_JUMP_B};
 static const uint32_t FAULT_DECODER[ODO_TRUCKS] = {ODO_FAULT_DECODER_A, ODO_FAULT_DECODER_B};
 
-/// Occurrence count of one fault bit.
-static uint32_t fault_count(const odo_fault_counters_t *c, uint32_t mask)
-{
-    for (unsigned b = 0U; b < ODO_FAULT_COUNT; ++b) {
-        if (mask == (1UL << b)) {
-            return c->count[b];
-        }
-    }
-    return 0U;
-}
+/// Bit indices of the two faults STATUS.Rejected counts (checked against odo_status.h below).
+#define FAULT_BIT_CAN_BAD_DLC    14U
+#define FAULT_BIT_CAN_UNKNOWN_ID 15U
+typedef char fault_bit_bad_dlc_matches[(1UL << FAULT_BIT_CAN_BAD_DLC) == ODO_FAULT_CAN_BAD_DLC ? 1 : -1];
+typedef char fault_bit_unknown_id_matches[(1UL << FAULT_BIT_CAN_UNKNOWN_ID) == ODO_FAULT_CAN_UNKNOWN_ID ? 1 : -1];
 
-static void publish(const odo_app_t *app, const uint8_t pose_flags[ODO_TRUCKS], odo_tick_output_t *out)
+/// Pack this tick's frames. A position beyond POSE_XY's range is sent saturated and flagged here,
+/// in out->faults and that truck's POSE_THETA flags, before STATUS is packed.
+static void publish(const odo_app_t *app, uint8_t pose_flags[ODO_TRUCKS], odo_tick_output_t *out)
 {
     uint8_t n = 0U;
     for (uint8_t i = 0U; i < app->trucks; ++i) {
-        const odo_msg_pose_xy_t xy = {odo_mm_q32_to_10um(out->pose[i].x_mm_q32),
-                                      odo_mm_q32_to_10um(out->pose[i].y_mm_q32)};
+        bool sat = false;
+        const odo_msg_pose_xy_t xy = {odo_mm_q32_to_10um(out->pose[i].x_mm_q32, &sat),
+                                      odo_mm_q32_to_10um(out->pose[i].y_mm_q32, &sat)};
+        if (sat) {
+            out->faults |= ODO_FAULT_POSE_XY_SATURATED;
+            pose_flags[i] |= ODO_POSE_FLAG_XY_SATURATED;
+        }
         const odo_msg_pose_theta_t th = {odo_heading_bam(&out->pose[i]), app->out_seq, pose_flags[i]};
         odo_can_pack_pose_xy(i, &xy, &out->frames[n++]);
         odo_can_pack_pose_theta(i, &th, &out->frames[n++]);
@@ -119,8 +144,11 @@ static void publish(const odo_app_t *app, const uint8_t pose_flags[ODO_TRUCKS], 
         const odo_msg_ipec_corr_t corr = {out->ipec_dtheta_bam[0], out->ipec_dtheta_bam[1]};
         odo_can_pack_ipec_corr(&corr, &out->frames[n++]);
     }
-    const uint64_t rejected = (uint64_t)fault_count(&app->faults, ODO_FAULT_CAN_BAD_DLC) +
-                              fault_count(&app->faults, ODO_FAULT_CAN_UNKNOWN_ID);
+    /* Rejected frames since boot, this tick's included (counted after publishing). */
+    const uint64_t rejected = (uint64_t)app->faults.count[FAULT_BIT_CAN_BAD_DLC] +
+                              app->faults.count[FAULT_BIT_CAN_UNKNOWN_ID] +
+                              ((out->faults >> FAULT_BIT_CAN_BAD_DLC) & 1U) +
+                              ((out->faults >> FAULT_BIT_CAN_UNKNOWN_ID) & 1U);
     const odo_msg_status_t st = {out->faults, app->out_seq, (uint8_t)app->params_status,
                                  (uint16_t)(rejected > UINT16_MAX ? UINT16_MAX : rejected)};
     odo_can_pack_status(&st, &out->frames[n++]);
@@ -156,6 +184,29 @@ static uint32_t ipec_tick(odo_app_t *app, const odo_tick_input_t *in, bool dr_ok
     return f;
 }
 
+/// One truck's wheel sample: sequence and decoder checks, then odometry over the ticks elapsed.
+/// Returns odo_step_t.range (the pose is beyond ODO_POSE_LIMIT_MM_Q32).
+static bool wheel_step(odo_app_t *app, uint8_t i, const odo_wheel_input_t *w, uint64_t t_us,
+                       uint32_t *faults, uint8_t *pose_flags, bool *dr_ok, odo_tick_output_t *out)
+{
+    if ((w->status & (ODO_WHEEL_STATUS_LEFT_SKIPPED | ODO_WHEEL_STATUS_RIGHT_SKIPPED |
+                      ODO_WHEEL_STATUS_LEFT_FAULT | ODO_WHEEL_STATUS_RIGHT_FAULT)) != 0U) {
+        *faults |= FAULT_DECODER[i];
+    }
+    uint32_t ticks = 1U;
+    *faults |= check_seq(app, i, w->seq, t_us, &ticks);
+    odo_step_t st;
+    odo_truck_step(&app->truck[i], &app->model[i], w->left_raw, w->right_raw, w->bits, ticks, &st);
+    if (st.jump) {
+        *dr_ok = false;
+        *faults |= FAULT_JUMP[i];
+        *pose_flags |= ODO_POSE_FLAG_JUMP;
+    }
+    out->dist_mm_q40[i] = st.dist_mm_q40;
+    out->dturn_q64[i] = st.dturn_q64;
+    return st.range;
+}
+
 void odo_app_step(odo_app_t *app, const odo_tick_input_t *in, odo_tick_output_t *out)
 {
     uint32_t faults = in->rx_faults;
@@ -174,26 +225,20 @@ void odo_app_step(odo_app_t *app, const odo_tick_input_t *in, odo_tick_output_t 
     bool dr_ok = true; /* every truck's sample integrated: IPEC may compare */
     for (uint8_t i = 0U; i < app->trucks; ++i) {
         const odo_wheel_input_t *w = &in->wheel[i];
+        bool range;
         if (!w->present) {
             dr_ok = false;
             faults |= FAULT_MISSING[i];
             pose_flags[i] |= ODO_POSE_FLAG_MISSING;
-            continue;
+            range = !odo_pose_in_range(&app->truck[i].pose);
+        } else {
+            range = wheel_step(app, i, w, in->t_us, &faults, &pose_flags[i], &dr_ok, out);
         }
-        faults |= check_seq(app, i, w->seq);
-        if ((w->status & (ODO_WHEEL_STATUS_LEFT_SKIPPED | ODO_WHEEL_STATUS_RIGHT_SKIPPED |
-                          ODO_WHEEL_STATUS_LEFT_FAULT | ODO_WHEEL_STATUS_RIGHT_FAULT)) != 0U) {
-            faults |= FAULT_DECODER[i];
+        if (range) {
+            dr_ok = false; /* held from the next step on; IPEC must not move it either */
+            faults |= ODO_FAULT_POSE_RANGE;
+            pose_flags[i] |= ODO_POSE_FLAG_RANGE;
         }
-        odo_step_t st;
-        odo_truck_step(&app->truck[i], &app->model[i], w->left_raw, w->right_raw, w->bits, &st);
-        if (st.jump) {
-            dr_ok = false;
-            faults |= FAULT_JUMP[i];
-            pose_flags[i] |= ODO_POSE_FLAG_JUMP;
-        }
-        out->dist_mm_q40[i] = st.dist_mm_q40;
-        out->dturn_q64[i] = st.dturn_q64;
     }
 
     if (app->trucks == 2U) {
@@ -204,8 +249,8 @@ void odo_app_step(odo_app_t *app, const odo_tick_input_t *in, odo_tick_output_t 
         out->pose[i] = app->truck[i].pose;
     }
     out->faults = faults;
-    count_faults(&app->faults, faults);
     publish(app, pose_flags, out);
+    count_faults(&app->faults, out->faults);
     app->out_seq++;
     app->ticks++;
 }

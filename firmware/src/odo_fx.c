@@ -66,41 +66,60 @@ static int64_t apply_sign(uint64_t mag, bool negative)
     return (mag == 0U) ? 0 : -(int64_t)(mag - 1U) - 1;
 }
 
+/// Apply a sign to a magnitude of 64 + `over` bits, saturating to INT64_MIN/INT64_MAX beyond
+/// int64. The common case (over == 0, mag < 2^63) costs one test.
+static int64_t apply_sign_sat(uint64_t over, uint64_t mag, bool negative)
+{
+    if ((over | (mag >> 63)) != 0U) {
+        return negative ? INT64_MIN : INT64_MAX; /* -2^63 itself lands on INT64_MIN exactly */
+    }
+    return negative ? -(int64_t)mag : (int64_t)mag;
+}
+
+/// round(p / 2^shift) of a 96-bit magnitude p = (hi : lo), ties away from zero, with the sign
+/// applied and saturated to int64 (the shared tail of the two mul-shifts below).
+static int64_t shr96_round_sat(uint64_t hi, uint64_t lo, unsigned shift, bool negative)
+{
+    /* Add half a unit of the result, then shift the 96-bit value. Whatever stays in `hi` after
+     * the shift is beyond 64 bits: saturate. */
+    if (shift - 1U < 63U) { /* 1..63, every caller in the firmware */
+        const uint64_t lo2 = lo + ((uint64_t)1U << (shift - 1U));
+        hi += (lo2 < lo) ? 1U : 0U;
+        return apply_sign_sat(hi >> shift, (lo2 >> shift) | (hi << (64U - shift)), negative);
+    }
+    if (shift == 0U) {
+        return apply_sign_sat(hi, lo, negative);
+    }
+    if (shift < 96U) {
+        /* The half unit sits in hi (or is lo's top bit); lo's other bits cannot carry into the
+         * result: floor((H + f) / 2^s) == floor(H / 2^s) for an integer H and 0 <= f < 1. */
+        const unsigned s = shift - 64U;
+        return apply_sign_sat(0U, (s == 0U) ? hi + (lo >> 63) : (hi + ((uint64_t)1U << (s - 1U))) >> s,
+                              negative);
+    }
+    return 0; /* p < 2^95: below half a unit */
+}
+
 int64_t odo_mul_s64_s32_shr(int64_t a, int32_t b, unsigned shift)
 {
-    const bool negative = (a < 0) != (b < 0);
     const uint64_t ua = mag_s64(a);
     const uint64_t ub = (uint64_t)mag_s64((int64_t)b); /* < 2^32 */
-    /* 96-bit product |a| * |b| = (hi32 : lo64). */
+    /* 96-bit product |a| * |b| = (hi : lo), at most 2^63 * 2^31 = 2^94. */
     const uint64_t p_lo = LO32(ua) * ub;
     const uint64_t p_hi = (ua >> 32) * ub;
-    uint64_t lo = p_lo + (p_hi << 32);
-    uint64_t hi = (p_hi >> 32) + (lo < p_lo ? 1U : 0U);
-    /* Round half away from zero on the magnitude, then shift the 96-bit value. */
-    const uint64_t half = (uint64_t)1U << (shift - 1U);
-    const uint64_t lo2 = lo + half;
-    hi += (lo2 < lo) ? 1U : 0U;
-    lo = lo2;
-    const uint64_t mag = (shift >= 64U) ? (hi >> (shift - 64U))
-                                        : ((lo >> shift) | (hi << (64U - shift)));
-    return apply_sign(mag, negative);
+    const uint64_t lo = p_lo + (p_hi << 32);
+    return shr96_round_sat((p_hi >> 32) + (lo < p_lo ? 1U : 0U), lo, shift, (a < 0) != (b < 0));
 }
 
 int64_t odo_mul_s64_u32_shr(int64_t a, uint32_t b, unsigned shift)
 {
     const uint64_t ua = mag_s64(a);
     const uint64_t ub = b;
-    /* 96-bit product |a| * b = (hi32 : lo64), rounded on the magnitude as odo_mul_s64_s32_shr. */
+    /* 96-bit product |a| * b = (hi : lo), below 2^95. */
     const uint64_t p_lo = LO32(ua) * ub;
     const uint64_t p_hi = (ua >> 32) * ub;
-    uint64_t lo = p_lo + (p_hi << 32);
-    uint64_t hi = (p_hi >> 32) + (lo < p_lo ? 1U : 0U);
-    const uint64_t half = (uint64_t)1U << (shift - 1U);
-    const uint64_t lo2 = lo + half;
-    hi += (lo2 < lo) ? 1U : 0U;
-    lo = lo2;
-    const uint64_t mag = (lo >> shift) | (hi << (64U - shift));
-    return apply_sign(mag, a < 0);
+    const uint64_t lo = p_lo + (p_hi << 32);
+    return shr96_round_sat((p_hi >> 32) + (lo < p_lo ? 1U : 0U), lo, shift, a < 0 && b != 0U);
 }
 
 /// Leading zero bits of a non-zero value; portable C (five steps), so no compiler builtin.
@@ -165,8 +184,15 @@ uint32_t odo_frac_q32(uint32_t n, uint32_t d)
 
 int64_t odo_shr_round_s64(int64_t v, unsigned shift)
 {
+    if (shift == 0U) {
+        return v;
+    }
     const uint64_t mag = mag_s64(v);
+    if (shift >= 64U) {
+        /* |v| / 2^64 <= 1/2, exactly 1/2 only for INT64_MIN (which rounds away to -1). */
+        return (shift == 64U && mag == ((uint64_t)1U << 63)) ? -1 : 0;
+    }
     const uint64_t half = (uint64_t)1U << (shift - 1U);
-    /* mag + half cannot wrap: mag <= 2^63 and half <= 2^61. */
+    /* mag + half cannot wrap: mag <= 2^63 and half <= 2^62. */
     return apply_sign((mag + half) >> shift, v < 0);
 }

@@ -99,8 +99,11 @@ uint32_t odo_ipec_check(odo_ipec_t *s, const odo_params_t *p, const odo_link_inp
         rd->beta_bam = decode_angle(in->beta_bam16, lp->beta_bias_bam, lp->rotary_bits);
         /* 002 s. 5.2: constant bias plus an eccentric part that grows as the trucks rotate
          * relative to each other, ecc (1 - cos(alpha - beta)) (host_sim's model). */
-        const int32_t c = odo_cos_q30((uint32_t)rd->alpha_bam - (uint32_t)rd->beta_bam);
-        const int64_t ecc_nm = odo_mul_s64_s32_shr((int64_t)lp->length_ecc_nm, ODO_Q30_ONE - c, 30U);
+        /* 1 - cos spans [0, 2]: 2^31 in Q30 at 180 deg, one past int32, so the product is formed
+         * in int64 (|ecc| < 2^31 times <= 2^31 stays below 2^62). */
+        const int64_t one_minus_cos_q30 = (int64_t)ODO_Q30_ONE -
+                                          odo_cos_q30((uint32_t)rd->alpha_bam - (uint32_t)rd->beta_bam);
+        const int64_t ecc_nm = odo_shr_round_s64((int64_t)lp->length_ecc_nm * one_minus_cos_q30, 30U);
         const int64_t l_nm = (int64_t)in->length_um * 1000 - lp->length_bias_nm - ecc_nm;
         rd->length_mm_q32 = odo_ipec_nm_to_mm_q32(l_nm);
     } else {

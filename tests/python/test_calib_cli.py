@@ -134,6 +134,10 @@ GOOD = [f"{k},{d},{10 + k},{-5 + k},1.0,0,0,0" for d in ("cw", "ccw") for k in (
     ([*GOOD[:2], "3,cw,1,2,3", *GOOD[3:]], ":4: 5 fields, expected 8"),
     ([*GOOD[:5], "3,ccw,nan,1,0,0,0,0"], ":7: field 3 (x_abs_mm): 'nan' is not a finite"),
     ([*GOOD[:5], "3,ccw,1,-inf,0,0,0,0"], ":7: field 4 (y_abs_mm): '-inf' is not a finite"),
+    # issue 16: theta 1e308 was taken, remainder(1e308, 360) came out as 0 deg
+    ([*GOOD[:5], "3,ccw,1,1,1e308,0,0,0"], ":7: field 5 (theta_abs_deg): '1e308' is beyond"),
+    ([*GOOD[:5], "3,ccw,1,1,0,0,0,-2e6"], ":7: field 8 (theta_calc_deg): '-2e6' is beyond"),
+    ([*GOOD[:5], "3,ccw,1e20,1,0,1e20,0,0"], ":7: field 3 (x_abs_mm): '1e20' is beyond"),
     (GOOD[:1] + GOOD[3:], "1 cw run: UMBmark needs at least 2 runs in each direction"),
     (GOOD[:3], "0 ccw runs"),
     ([*GOOD[:5], "3,sideways,1,1,0,0,0,0"], "must be cw or ccw"),

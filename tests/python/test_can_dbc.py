@@ -305,6 +305,44 @@ def test_status_param_state_names_follow_odo_params_status(db: Database) -> None
     assert [str(sig.choices[i]) for i in range(len(names))] == names
 
 
+def header_bits(path: Path, pattern: str) -> dict[int, str]:
+    """Bit index -> name of the macros matching `pattern` (two groups: name, bit or mask)."""
+    bits = {}
+    for name, value in re.findall(pattern, path.read_text()):
+        v = int(value, 0)
+        index = v if "<<" in pattern else v.bit_length() - 1
+        bits[index] = name
+    return bits
+
+
+def documented_bits(text: str) -> dict[int, str]:
+    return {int(i): name for i, name in re.findall(r"\bbit(\d+) ([A-Z][A-Z0-9_]+)", text)}
+
+
+def readme_bits(table_header: str) -> dict[int, str]:
+    text = (SOURCE_DIR / "can" / "README.md").read_text()
+    table = text.split(table_header, 1)[1].split("\n\n", 1)[0]
+    return {int(i): name for i, name in re.findall(r"^\| (\d+) \| ([A-Z0-9_]+) \|", table, re.M)}
+
+
+def test_fault_and_flag_bits_are_documented_as_the_headers_define_them(db: Database) -> None:
+    """One source per contract: the bit names and positions of STATUS.Faults (odo_status.h) and
+    POSE_THETA.Flags (odo_app.h) are what the DBC's comments and can/README.md say they are."""
+    include = SOURCE_DIR / "firmware" / "include" / "odo"
+    faults = header_bits(include / "odo_status.h", r"#define ODO_FAULT_(\w+)\s+\(1UL << (\d+)\)")
+    flags = header_bits(include / "odo_app.h", r"#define ODO_POSE_FLAG_(\w+)\s+(0x[0-9A-Fa-f]+)U")
+    count = re.search(r"#define ODO_FAULT_COUNT (\d+)U", (include / "odo_status.h").read_text())
+    assert count is not None and len(faults) == int(count.group(1))
+    assert faults and flags
+    status = db.get_message_by_name("STATUS").get_signal_by_name("Faults")
+    assert documented_bits(status.comment) == faults
+    assert readme_bits("| Faults bit | name |") == faults
+    for msg in ("POSE_THETA_A", "POSE_THETA_B"):
+        comment = db.get_message_by_name(msg).get_signal_by_name("Flags").comment
+        assert documented_bits(comment) == flags
+    assert readme_bits("| Flags bit | name |") == flags
+
+
 # ---- odo-canvec's own contract (the batch must survive bad lines) ----
 
 

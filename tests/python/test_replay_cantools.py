@@ -195,3 +195,87 @@ def test_params_block_and_its_json_give_the_same_replay(tmp_path: Path, sim_log:
     bad.write_text('{"vehicle": 0}')
     r = run("--log", str(sim_log), "--params", str(bad), "--out", str(tmp_path / "o"))
     assert r.returncode == 1 and "bad.json" in r.stderr
+
+
+# ---- issue 16: inputs that crashed, ground or corrupted the output before ----
+
+
+def test_rotary_readings_180_deg_apart_replay_cleanly(tmp_path: Path) -> None:
+    """The issue's reproducer: two frames whose rotary angles are exactly 180 deg apart reached
+    signed overflow (a UBSan abort, and o.tmp.PID left behind); now an ordinary tick."""
+    log = write(tmp_path / "ub.log", ["(0.000000) can0 120#000000800103",
+                                      "(0.000000) can0 121#40420F000104"])
+    out = tmp_path / "o"
+    r = run("--log", str(log), "--robot", str(ROBOT), "--out", str(out), "--quiet")
+    assert r.returncode == 0, r.stderr
+    assert "runtime error" not in r.stderr
+    assert json.loads((out / "summary.json").read_text())["ticks"] == 1
+    assert not list(tmp_path.glob("o.tmp.*"))
+
+
+def test_paths_with_quotes_and_backslashes_give_valid_json(tmp_path: Path) -> None:
+    """summary.json names its input: a path with a quote used to make it invalid JSON."""
+    d = tmp_path / 'we"ird\\dir'
+    d.mkdir()
+    log = write(d / 'run "1".log', GOOD)
+    out = d / 'out"put'
+    r = run("--log", str(log), "--params", str(params_bin(tmp_path)), "--out", str(out), "--quiet")
+    assert r.returncode == 0, r.stderr
+    s = json.loads((out / "summary.json").read_text())
+    assert s["input"] == str(log) and s["ticks"] == 5
+
+
+def gap_log(tmp_path: Path, gap_s: float) -> Path:
+    """Ten ticks of a labmate driving 1 count a tick, a gap of gap_s seconds, ten more."""
+    lines = []
+    for k in range(20):
+        t = k * 0.04 + (gap_s if k >= 10 else 0.0)
+        lines.append(f"({t:.6f}) can0 110#{k:02X}0000{k:02X}0000{k:02X}00")
+    return write(tmp_path / f"gap-{gap_s:g}.log", lines)
+
+
+@pytest.mark.parametrize("gap_s", [1e5, 1e12])
+def test_a_long_gap_is_reported_and_skipped(tmp_path: Path, gap_s: float) -> None:
+    """A 1e5 s gap was ground through as 2.5 M empty ticks (794 MB) without a word; 1e12 s never
+    ended. It is skipped, said on stderr (file and line) and counted in the summary."""
+    out = tmp_path / "out"
+    r = run("--log", str(gap_log(tmp_path, gap_s)), "--params", str(params_bin(tmp_path)),
+            "--out", str(out), "--quiet")
+    assert r.returncode == 0, r.stderr
+    assert f"gap-{gap_s:g}.log:11: a gap of " in r.stderr and "skipped" in r.stderr, r.stderr
+    s = json.loads((out / "summary.json").read_text())
+    assert s["ticks"] == 20 and s["gaps_skipped"] == 1
+    assert s["gap_skipped_s"] == pytest.approx(gap_s + 0.04, rel=1e-9)
+    rows = list(csv.DictReader((out / "poses.csv").open()))
+    assert len(rows) == 20
+    assert float(rows[10]["t_s"]) == pytest.approx(gap_s + 0.4, rel=1e-9)  # the log's clock
+    assert int(rows[10]["faults"], 16) & 0x2  # the reading across the gap is not trusted
+
+
+def test_a_clock_step_back_is_re_anchored(tmp_path: Path) -> None:
+    """The sender's clock steps back 2 s after five ticks: the frames open new ticks (not folded
+    into the open one), and only the tick where time went back is flagged TIME_BACKWARDS."""
+    t = [10.0 + k * 0.04 - (2.0 if k >= 5 else 0.0) for k in range(10)]
+    lines = [f"({t[k]:.6f}) can0 110#{k:02X}0000{k:02X}0000{k:02X}00" for k in range(10)]
+    out = tmp_path / "out"
+    r = run("--log", str(write(tmp_path / "back.log", lines)), "--params",
+            str(params_bin(tmp_path)), "--out", str(out))
+    assert r.returncode == 0, r.stderr
+    assert "clock stepped back 1 time(s)" in r.stderr
+    s = json.loads((out / "summary.json").read_text())
+    assert (s["ticks"], s["clock_steps"], s["time_backwards"]) == (10, 1, 1)
+    rows = list(csv.DictReader((out / "poses.csv").open()))
+    backwards = [int(row["faults"], 16) & (1 << 17) != 0 for row in rows]
+    assert backwards == [False] * 5 + [True] + [False] * 4
+
+
+def test_outputs_that_cannot_be_created_leave_no_temp_folder(tmp_path: Path) -> None:
+    """Out of file descriptors after DIR.tmp.PID was made (the second output cannot be opened):
+    a clear error, exit 1, and the temp folder removed with what it held."""
+    log = write(tmp_path / "in.log", GOOD)
+    r = subprocess.run(["bash", "-c", 'ulimit -n 5 && exec "$@"', "odo-replay",
+                        str(BIN / "odo-replay"), "--log", str(log), "--params",
+                        str(params_bin(tmp_path)), "--out", str(tmp_path / "o")],
+                       capture_output=True, text=True, timeout=60)
+    assert r.returncode == 1 and "cannot create outputs in" in r.stderr, r.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["in.log", "p.bin"]

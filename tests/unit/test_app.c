@@ -1,4 +1,5 @@
 /// The 40 ms application step: parameter boot rule, fault flags, output frames.
+#include <math.h>
 #include <string.h>
 
 #include "odo/odo_app.h"
@@ -185,6 +186,211 @@ static void step_is_deterministic_for_identical_inputs(void)
     TEST_ASSERT_EQUAL_MEMORY(&a.truck, &b.truck, sizeof a.truck);
 }
 
+/* -------------------------------------------------------------------------------------------
+ * Faults at speed and silent limits (issue 16): each of these failed on the code before it.
+ * ------------------------------------------------------------------------------------------- */
+
+#define K_MM (3.14159265358979323846 * 150.0 / 39000.0) /* the default labmate: mm per count */
+#define MM_OF_Q32(v) ((double)(v) / 4294967296.0)
+
+static void boot_defaults(uint8_t counter_bits)
+{
+    odo_params_t p;
+    odo_params_defaults(&p);
+    p.counter_bits = counter_bits;
+    TEST_ASSERT_EQUAL(ODO_PARAMS_OK, odo_app_init_params(&app, &p));
+}
+
+/// Straight driving at v mm/s; the samples whose index is in `lost` never arrive. Returns x (mm).
+static double drive_straight(uint8_t bits, double v_mm_s, uint32_t ticks, const uint32_t *lost, size_t n_lost,
+                             uint32_t *faults_or)
+{
+    boot_defaults(bits);
+    const double per_tick = v_mm_s * 0.04 / K_MM;
+    *faults_or = 0U;
+    size_t next = 0U;
+    for (uint32_t k = 0U; k < ticks; ++k) {
+        const uint32_t c = ts_wrap_counter((int64_t)llround(per_tick * k), bits);
+        odo_tick_input_t in = tick(40000ULL * k, c, c, (uint8_t)k);
+        in.wheel[0].bits = bits;
+        if (next < n_lost && lost[next] == k) {
+            in.wheel[0].present = false;
+            next++;
+        }
+        odo_app_step(&app, &in, &out);
+        *faults_or |= out.faults;
+    }
+    return MM_OF_Q32(app.truck[0].pose.x_mm_q32);
+}
+
+/// Counters are cumulative (000 Eq. 2.3 sums counts), so a sample after lost ones carries their
+/// motion: the plausibility limit scales with the ticks elapsed. At 2.5 m/s a two-tick delta is
+/// above the one-tick limit of 3 m/s, and the old guard threw every such sample away.
+static void lost_samples_at_speed_lose_no_travel(void)
+{
+    static const uint32_t lost[] = {10, 20, 21, 30, 31, 32, 40, 41, 42, 43, 60, 61, 62, 63, 64, 65, 66, 67};
+    uint32_t f_clean, f_lossy;
+    const double clean = drive_straight(24U, 2500.0, 100U, NULL, 0U, &f_clean);
+    const double lossy = drive_straight(24U, 2500.0, 100U, lost, sizeof lost / sizeof lost[0], &f_lossy);
+    TEST_ASSERT_EQUAL_UINT32(0U, f_clean);
+    TEST_ASSERT_NOT_EQUAL(0U, f_lossy & ODO_FAULT_SEQ_GAP);
+    TEST_ASSERT_EQUAL_UINT32(0U, f_lossy & ODO_FAULT_COUNTER_JUMP_A);
+    TEST_ASSERT_DOUBLE_WITHIN(K_MM, 99.0 * 100.0, clean); /* 99 ticks of 100 mm */
+    TEST_ASSERT_DOUBLE_WITHIN(1e-6, clean, lossy);
+}
+
+/// A 16-bit counter at the 3 m/s limit (9933 counts a tick) can tell a reading 3 ticks after the
+/// previous one (29,799 counts < 2^15) but not 4 (39,732): then the reading is ambiguous whatever
+/// it says, so it is flagged and not integrated, even when it looks small.
+static void a_gap_the_counter_width_cannot_tell_is_flagged_not_integrated(void)
+{
+    static const uint32_t lost2[] = {10, 11};
+    uint32_t f;
+    const double clean = drive_straight(16U, 2000.0, 30U, NULL, 0U, &f);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-6, clean, drive_straight(16U, 2000.0, 30U, lost2, 2U, &f));
+    TEST_ASSERT_EQUAL_UINT32(0U, f & ODO_FAULT_COUNTER_JUMP_A);
+
+    boot_defaults(16U);
+    odo_tick_input_t in = tick(0U, 100U, 100U, 0U);
+    in.wheel[0].bits = 16U;
+    odo_app_step(&app, &in, &out);
+    in = tick(4U * 40000U, 200U, 200U, 4U); /* 3 samples lost: 100 counts moved, or 65,636? */
+    in.wheel[0].bits = 16U;
+    odo_app_step(&app, &in, &out);
+    TEST_ASSERT_NOT_EQUAL(0U, out.faults & ODO_FAULT_COUNTER_JUMP_A);
+    TEST_ASSERT_EQUAL_INT64(0, app.truck[0].pose.x_mm_q32);
+    in = tick(5U * 40000U, 300U, 300U, 5U); /* from the re-taken baseline */
+    in.wheel[0].bits = 16U;
+    odo_app_step(&app, &in, &out);
+    TEST_ASSERT_EQUAL_UINT32(0U, out.faults);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-6, 100.0 * K_MM, MM_OF_Q32(app.truck[0].pose.x_mm_q32));
+}
+
+/// The sequence number wraps at 256, so from 128 ticks on the clock counts the gap: 12 s at
+/// 0.5 m/s (300 ticks, sequence step 44) is within what 24 bits can tell (300 x 9933 < 2^23) and
+/// is integrated; 36 s (900 ticks) is not, whatever the reading.
+static void gaps_beyond_the_sequence_wrap_are_counted_by_the_clock(void)
+{
+    boot_defaults(24U);
+    odo_tick_input_t in = tick(0U, 0U, 0U, 0U);
+    odo_app_step(&app, &in, &out);
+    const uint32_t moved = (uint32_t)llround(6000.0 / K_MM); /* 6 m */
+    in = tick(300U * 40000U, moved, moved, (uint8_t)300U);
+    odo_app_step(&app, &in, &out);
+    TEST_ASSERT_NOT_EQUAL(0U, out.faults & ODO_FAULT_SEQ_GAP);
+    TEST_ASSERT_EQUAL_UINT32(0U, out.faults & ODO_FAULT_COUNTER_JUMP_A);
+    TEST_ASSERT_DOUBLE_WITHIN(K_MM, 6000.0, MM_OF_Q32(app.truck[0].pose.x_mm_q32));
+
+    in = tick(1200U * 40000U, moved + 5000U, moved + 5000U, (uint8_t)1200U); /* 900 ticks later */
+    odo_app_step(&app, &in, &out);
+    TEST_ASSERT_NOT_EQUAL(0U, out.faults & ODO_FAULT_COUNTER_JUMP_A);
+    TEST_ASSERT_DOUBLE_WITHIN(K_MM, 6000.0, MM_OF_Q32(app.truck[0].pose.x_mm_q32));
+}
+
+/// CAN frames carry 24 bits of count (can/odometry.dbc). With counter_bits 32 and a wheel that may
+/// turn more than 2^23 counts in a tick (4e6 counts per turn of a 10 mm wheel at 3 m/s: 15.3 M),
+/// a 24-bit delta is ambiguous: +9 M read as -7.8 M was integrated backwards. It is flagged now.
+/// Within the frame's range (the labmate) 32-bit counters fed 24-bit frames wrap at 2^24.
+static void counts_in_24_bit_frames_are_judged_by_the_frame_width(void)
+{
+    odo_params_t p;
+    odo_params_defaults(&p);
+    p.counter_bits = 32U;
+    p.truck[0].wheel_diameter_nm = 10000000U;
+    p.truck[0].counts_per_rev_milli = 4000000000U;
+    TEST_ASSERT_EQUAL(ODO_PARAMS_OK, odo_app_init_params(&app, &p));
+    TEST_ASSERT_TRUE(app.model[0].max_counts > (1UL << 23));
+    odo_tick_input_t in = tick(0U, 0U, 0U, 0U);
+    odo_app_step(&app, &in, &out);
+    in = tick(40000U, 9000000U, 9000000U, 1U); /* 9 M counts forward: 70.7 mm */
+    odo_app_step(&app, &in, &out);
+    TEST_ASSERT_NOT_EQUAL(0U, out.faults & ODO_FAULT_COUNTER_JUMP_A);
+    TEST_ASSERT_TRUE(app.truck[0].pose.x_mm_q32 >= 0); /* never backwards */
+
+    boot_defaults(32U);
+    in = tick(0U, 0x00FFFFF0U, 0x00FFFFF0U, 0U);
+    odo_app_step(&app, &in, &out);
+    in = tick(40000U, 0x00000010U, 0x00000010U, 1U); /* across the frame's 2^24 wrap: +32 */
+    odo_app_step(&app, &in, &out);
+    TEST_ASSERT_EQUAL_UINT32(0U, out.faults);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-6, 32.0 * K_MM, MM_OF_Q32(app.truck[0].pose.x_mm_q32));
+}
+
+/// A sample that says it carries 0 bits reached 1 << -1 (undefined) in the counter delta. It
+/// carries no information: flagged, not integrated.
+static void a_sample_of_zero_bits_is_refused(void)
+{
+    boot_defaults(24U);
+    odo_tick_input_t in = tick(0U, 0U, 0U, 0U);
+    odo_app_step(&app, &in, &out);
+    in = tick(40000U, 500U, 500U, 1U);
+    in.wheel[0].bits = 0U;
+    odo_app_step(&app, &in, &out);
+    TEST_ASSERT_NOT_EQUAL(0U, out.faults & ODO_FAULT_COUNTER_JUMP_A);
+    TEST_ASSERT_EQUAL_INT64(0, app.truck[0].pose.x_mm_q32);
+}
+
+static uint8_t pose_flags_of_a(void)
+{
+    odo_msg_pose_theta_t th;
+    uint8_t truck = 9U;
+    TEST_ASSERT_EQUAL(ODO_CAN_OK, odo_can_unpack_pose_theta(&out.frames[1], &truck, &th));
+    return th.flags;
+}
+
+/// Position is int64 mm Q32: it overflowed (undefined) 2^31 mm from the origin. The odometry now
+/// holds a pose beyond ODO_POSE_LIMIT_MM_Q32 (2^29 mm) and says so every tick, before anything
+/// can overflow.
+static void a_pose_beyond_the_integrable_range_is_held_and_flagged(void)
+{
+    boot_defaults(24U);
+    odo_tick_input_t in = tick(0U, 0U, 0U, 0U);
+    odo_app_step(&app, &in, &out);
+    app.truck[0].pose.x_mm_q32 = INT64_MAX - 1000; /* one more forward step would overflow */
+    in = tick(40000U, 8000U, 8000U, 1U);
+    odo_app_step(&app, &in, &out);
+    TEST_ASSERT_NOT_EQUAL(0U, out.faults & ODO_FAULT_POSE_RANGE);
+    TEST_ASSERT_NOT_EQUAL(0U, pose_flags_of_a() & ODO_POSE_FLAG_RANGE);
+    TEST_ASSERT_EQUAL_INT64(INT64_MAX - 1000, app.truck[0].pose.x_mm_q32);
+
+    /* just inside the limit a step still integrates; the tick that crosses it raises the flag */
+    app.truck[0].pose.x_mm_q32 = ODO_POSE_LIMIT_MM_Q32 - ((int64_t)50 << 32); /* 50 mm short */
+    in = tick(80000U, 16000U, 16000U, 2U); /* 96.7 mm */
+    odo_app_step(&app, &in, &out);
+    TEST_ASSERT_TRUE(app.truck[0].pose.x_mm_q32 > ODO_POSE_LIMIT_MM_Q32);
+    TEST_ASSERT_NOT_EQUAL(0U, out.faults & ODO_FAULT_POSE_RANGE);
+    const int64_t held = app.truck[0].pose.x_mm_q32;
+    in = tick(120000U, 24000U, 24000U, 3U);
+    odo_app_step(&app, &in, &out);
+    TEST_ASSERT_EQUAL_INT64(held, app.truck[0].pose.x_mm_q32);
+    TEST_ASSERT_EQUAL_UINT32(3U, app.faults.count[18]); /* every tick beyond the limit */
+}
+
+/// POSE_XY carries +-21.47 km (int32 of 10 um); beyond it the frame saturated with no word. The
+/// frame still saturates, and STATUS and POSE_THETA say so; the pose itself goes on.
+static void a_pose_beyond_the_pose_xy_frame_is_flagged(void)
+{
+    boot_defaults(24U);
+    odo_tick_input_t in = tick(0U, 0U, 0U, 0U);
+    odo_app_step(&app, &in, &out);
+    TEST_ASSERT_EQUAL_UINT32(0U, out.faults);
+    app.truck[0].pose.x_mm_q32 = (int64_t)21474836 << 32; /* 21,474.836 km: still fits */
+    app.truck[0].pose.y_mm_q32 = -((int64_t)21474836 << 32);
+    in = tick(40000U, 0U, 0U, 1U);
+    odo_app_step(&app, &in, &out);
+    TEST_ASSERT_EQUAL_UINT32(0U, out.faults);
+    in = tick(80000U, 1000U, 1000U, 2U); /* 12 mm further */
+    odo_app_step(&app, &in, &out);
+    TEST_ASSERT_NOT_EQUAL(0U, out.faults & ODO_FAULT_POSE_XY_SATURATED);
+    TEST_ASSERT_NOT_EQUAL(0U, pose_flags_of_a() & ODO_POSE_FLAG_XY_SATURATED);
+    odo_msg_pose_xy_t xy;
+    uint8_t truck = 9U;
+    TEST_ASSERT_EQUAL(ODO_CAN_OK, odo_can_unpack_pose_xy(&out.frames[0], &truck, &xy));
+    TEST_ASSERT_EQUAL_INT32(INT32_MAX, xy.x_10um);
+    TEST_ASSERT_EQUAL_INT32(-2147483600, xy.y_10um); /* y still fits */
+    TEST_ASSERT_DOUBLE_WITHIN(1e-3, 21474836.0 + 1000.0 * K_MM, MM_OF_Q32(app.truck[0].pose.x_mm_q32));
+}
+
 /// A 12-bit decoder behind 24-bit CAN frames (the OptiOdom robot's width): the app takes deltas
 /// modulo 2^12, so driving forward and back across the counter's wrap many times loses nothing,
 /// and no wrap looks like a counter jump; a block carrying that width boots.
@@ -233,6 +439,13 @@ int main(void)
     RUN_TEST(missing_duplicated_and_lost_frames_are_flagged);
     RUN_TEST(impossible_jumps_decoder_errors_and_time_reversal_are_flagged);
     RUN_TEST(step_is_deterministic_for_identical_inputs);
+    RUN_TEST(lost_samples_at_speed_lose_no_travel);
+    RUN_TEST(a_gap_the_counter_width_cannot_tell_is_flagged_not_integrated);
+    RUN_TEST(gaps_beyond_the_sequence_wrap_are_counted_by_the_clock);
+    RUN_TEST(counts_in_24_bit_frames_are_judged_by_the_frame_width);
+    RUN_TEST(a_sample_of_zero_bits_is_refused);
+    RUN_TEST(a_pose_beyond_the_integrable_range_is_held_and_flagged);
+    RUN_TEST(a_pose_beyond_the_pose_xy_frame_is_flagged);
     RUN_TEST(twelve_bit_counters_wrap_both_ways_through_the_app);
     return UNITY_END();
 }

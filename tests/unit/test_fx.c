@@ -179,6 +179,76 @@ static void shr_round_is_symmetric_and_safe_at_the_extremes(void)
     TEST_ASSERT_EQUAL_INT64(INT64_MAX / 4 + 1, odo_shr_round_s64(INT64_MAX, 2U));
 }
 
+#ifdef __SIZEOF_INT128__
+/// round(p / 2^shift) ties away from zero, saturated to int64: the contract of both functions.
+static int64_t ref_shr(__int128 p, unsigned shift)
+{
+    __int128 q;
+    if (shift >= 120U) {
+        q = 0; /* every product here is below 2^95 */
+    } else {
+        const __int128 mag = p < 0 ? -p : p;
+        const __int128 half = shift == 0U ? 0 : (__int128)1 << (shift - 1U);
+        q = (mag + half) >> shift;
+        q = p < 0 ? -q : q;
+    }
+    if (q > INT64_MAX) {
+        return INT64_MAX;
+    }
+    if (q < INT64_MIN) {
+        return INT64_MIN;
+    }
+    return (int64_t)q;
+}
+#endif
+
+/// odo_fx.h: every shift is valid, 0 and 64-127 included, and a result beyond int64 saturates
+/// (shift 0 used to read 1 << -1, undefined behaviour under UBSan), for both mul-shifts.
+static void shifts_are_defined_for_every_shift_and_saturate(void)
+{
+    TEST_ASSERT_EQUAL_INT64(-15, odo_mul_s64_s32_shr(5, -3, 0U));
+    TEST_ASSERT_EQUAL_INT64(INT64_MAX, odo_mul_s64_s32_shr(INT64_MAX, 2, 0U));
+    TEST_ASSERT_EQUAL_INT64(INT64_MIN, odo_mul_s64_s32_shr(INT64_MIN, 1, 0U));
+    TEST_ASSERT_EQUAL_INT64(INT64_MAX, odo_mul_s64_s32_shr(INT64_MIN, -1, 0U)); /* 2^63 saturates */
+    TEST_ASSERT_EQUAL_INT64(1, odo_mul_s64_s32_shr(INT64_MIN, INT32_MIN, 95U));  /* exactly 1/2 */
+    TEST_ASSERT_EQUAL_INT64(0, odo_mul_s64_s32_shr(INT64_MIN, INT32_MIN, 96U));
+    TEST_ASSERT_EQUAL_INT64(0, odo_mul_s64_s32_shr(INT64_MAX, INT32_MAX, 200U));
+    TEST_ASSERT_EQUAL_INT64(INT64_MAX, odo_mul_s64_u32_shr(INT64_MAX, UINT32_MAX, 0U));
+    TEST_ASSERT_EQUAL_INT64(-7, odo_mul_s64_u32_shr(-7, 1U, 0U));
+    TEST_ASSERT_EQUAL_INT64(-1, odo_mul_s64_u32_shr(INT64_MIN, UINT32_MAX, 95U)); /* -(1 - 2^-32) */
+    TEST_ASSERT_EQUAL_INT64(0, odo_mul_s64_u32_shr(INT64_MIN, UINT32_MAX, 96U));  /* below 1/2 */
+    TEST_ASSERT_EQUAL_INT64(-7, odo_shr_round_s64(-7, 0U));
+    TEST_ASSERT_EQUAL_INT64(-1, odo_shr_round_s64(INT64_MIN, 63U));
+    TEST_ASSERT_EQUAL_INT64(-1, odo_shr_round_s64(INT64_MIN, 64U));
+    TEST_ASSERT_EQUAL_INT64(0, odo_shr_round_s64(INT64_MAX, 64U));
+    TEST_ASSERT_EQUAL_INT64(0, odo_shr_round_s64(INT64_MIN, 65U));
+    TEST_ASSERT_EQUAL_INT64(0, odo_shr_round_s64(INT64_MIN, UINT32_MAX));
+#ifdef __SIZEOF_INT128__
+    const int64_t ea[] = {0, 1, -1, 3, -3, INT64_MAX, INT64_MIN, INT64_MAX - 1, INT64_MIN + 1,
+                          (int64_t)1 << 62, -((int64_t)1 << 62)};
+    const int32_t eb[] = {0, 1, -1, 2, -2, INT32_MAX, INT32_MIN, 1 << 30, -(1 << 30)};
+    for (unsigned shift = 0U; shift < 128U; ++shift) {
+        for (unsigned i = 0U; i < sizeof ea / sizeof ea[0]; ++i) {
+            TEST_ASSERT_EQUAL_INT64(ref_shr(ea[i], shift), odo_shr_round_s64(ea[i], shift));
+            for (unsigned j = 0U; j < sizeof eb / sizeof eb[0]; ++j) {
+                const __int128 p = (__int128)ea[i] * eb[j];
+                TEST_ASSERT_EQUAL_INT64(ref_shr(p, shift), odo_mul_s64_s32_shr(ea[i], eb[j], shift));
+                const uint32_t ub = (uint32_t)eb[j];
+                TEST_ASSERT_EQUAL_INT64(ref_shr((__int128)ea[i] * ub, shift), odo_mul_s64_u32_shr(ea[i], ub, shift));
+            }
+        }
+        for (int n = 0; n < 2000; ++n) {
+            const int64_t a = (int64_t)spread_u64();
+            const uint32_t u = (uint32_t)spread_u64();
+            const int32_t b = (int32_t)u;
+            TEST_ASSERT_EQUAL_INT64(ref_shr(a, shift), odo_shr_round_s64(a, shift));
+            TEST_ASSERT_EQUAL_INT64(ref_shr((__int128)a * b, shift), odo_mul_s64_s32_shr(a, b, shift));
+            TEST_ASSERT_EQUAL_INT64(ref_shr((__int128)a * u, shift), odo_mul_s64_u32_shr(a, u, shift));
+        }
+    }
+#endif
+}
+
 int main(void)
 {
     ts_rng_seed(&rng, 0x0D0F00D5EEDULL);
@@ -187,6 +257,7 @@ int main(void)
     RUN_TEST(muldiv_rounds_to_nearest_and_reports_overflow);
     RUN_TEST(mul_s64_s32_shr_is_exact_through_96_bits);
     RUN_TEST(shr_round_is_symmetric_and_safe_at_the_extremes);
+    RUN_TEST(shifts_are_defined_for_every_shift_and_saturate);
     RUN_TEST(mul_s64_u32_shr_is_exact_through_96_bits);
     RUN_TEST(frac_q32_is_the_correctly_rounded_fraction);
     return UNITY_END();

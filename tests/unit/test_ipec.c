@@ -287,6 +287,44 @@ static void out_of_order_and_duplicated_linkage_frames_gate_the_tick(void)
     assert_gated(&in, ODO_FAULT_SEQ_DUP);
 }
 
+/// The link check runs every tick on a two-truck vehicle, IPEC on or off. Rotary readings exactly
+/// 180 deg apart make 1 - cos(alpha - beta) = 2, one past int32 in Q30 (it overflowed there, undefined
+/// behaviour from two CAN frames); the eccentric bias (002 s. 5.2) is then twice length_ecc_nm.
+static void rotary_readings_180_deg_apart_give_twice_the_eccentric_bias(void)
+{
+    odo_params_t p = clapper_params((uint8_t)ODO_IPEC_OFF);
+    p.link.length_ecc_nm = 3000000;   /* 3 mm */
+    p.link.length_bias_nm = -1000000; /* -1 mm */
+    p.link.length_min_um = 1000U;
+    p.link.length_max_um = 20000000U;
+    const uint16_t half_step = (uint16_t)(1U << (16U - p.link.rotary_bits - 1U));
+    const uint16_t codes[][2] = {{0x0000U, 0x8000U}, {0x8000U, 0x0000U}, {0x4000U, 0xC000U}, {0x1230U, 0x1230U}};
+    for (unsigned i = 0; i < sizeof codes / sizeof codes[0]; ++i) {
+        odo_ipec_t s;
+        odo_ipec_init(&s);
+        odo_link_input_t in;
+        memset(&in, 0, sizeof in);
+        in.rotary_present = in.linear_present = true;
+        in.rotary_status = ODO_LINK_STATUS_ALPHA_VALID | ODO_LINK_STATUS_BETA_VALID;
+        in.linear_status = ODO_LINK_STATUS_LENGTH_VALID;
+        in.alpha_bam16 = (uint16_t)(codes[i][0] - half_step); /* decoded at the code centre */
+        in.beta_bam16 = (uint16_t)(codes[i][1] - half_step);
+        in.length_um = 1000000U;
+        odo_ipec_reading_t rd;
+        TEST_ASSERT_EQUAL_UINT32(0U, odo_ipec_check(&s, &p, &in, &rd));
+        const double rel = 2.0 * M_PI * ((double)(int16_t)(uint16_t)(codes[i][0] - codes[i][1]) / 65536.0);
+        const double want_mm = 1000.0 + 1.0 - 3.0 * (1.0 - cos(rel));
+        TEST_ASSERT_DOUBLE_WITHIN(1e-6, want_mm, mm(rd.length_mm_q32));
+    }
+    /* and through the app with IPEC off, as the reproducer's two frames reach it */
+    TEST_ASSERT_EQUAL(ODO_PARAMS_OK, odo_app_init_params(&app, &p));
+    odo_tick_input_t in = good(0U);
+    in.link.alpha_bam16 = 0x0000U;
+    in.link.beta_bam16 = 0x8000U;
+    odo_app_step(&app, &in, &out);
+    TEST_ASSERT_EQUAL_UINT32(0U, out.faults);
+}
+
 static void a_missing_wheel_sample_gates_ipec_too(void)
 {
     boot((uint8_t)ODO_IPEC_PAPER);
@@ -313,5 +351,6 @@ int main(void)
     RUN_TEST(an_impossible_jump_gates_the_tick);
     RUN_TEST(out_of_order_and_duplicated_linkage_frames_gate_the_tick);
     RUN_TEST(a_missing_wheel_sample_gates_ipec_too);
+    RUN_TEST(rotary_readings_180_deg_apart_give_twice_the_eccentric_bias);
     return UNITY_END();
 }

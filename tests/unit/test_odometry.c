@@ -36,7 +36,7 @@ static odo_truck_t truck_at_origin(const odo_model_t *m, uint32_t left, uint32_t
     const odo_pose_t origin = {0, 0, 0U};
     odo_truck_reset(&t, &origin);
     odo_step_t st;
-    odo_truck_step(&t, m, left, right, bits, &st);
+    odo_truck_step(&t, m, left, right, bits, 1U, &st);
     TEST_ASSERT_FALSE(st.jump);
     return t;
 }
@@ -105,7 +105,7 @@ static void straight_line_keeps_heading_and_lateral_position_exact(void)
     odo_step_t st;
     for (int i = 0; i < 5000; ++i) {
         c = (c + 661U) & 0xFFFFFFU;
-        odo_truck_step(&t, &m, c, c, 24U, &st);
+        odo_truck_step(&t, &m, c, c, 24U, 1U, &st);
         TEST_ASSERT_FALSE(st.jump);
     }
     TEST_ASSERT_EQUAL_UINT64(0U, t.pose.heading_q64);
@@ -122,7 +122,7 @@ static void on_the_spot_turn_changes_heading_not_position(void)
     int64_t n = 0;
     for (int i = 1; i <= 250; ++i) { /* 250 ticks of +-300 counts */
         n += 300;
-        odo_truck_step(&t, &m, ts_wrap_counter(-n, 24U), ts_wrap_counter(n, 24U), 24U, &st);
+        odo_truck_step(&t, &m, ts_wrap_counter(-n, 24U), ts_wrap_counter(n, 24U), 24U, 1U, &st);
     }
     const double want = 2.0 * (double)n * cm_mm(&tp) / 340.0; /* Eq. 2.4 summed */
     const double got = TURNS_Q64_TO_RAD(t.pose.heading_q64);
@@ -143,7 +143,7 @@ static double arc_end_error_mm(uint8_t form)
     odo_truck_t t = truck_at_origin(&m, 0U, 0U, 32U);
     odo_step_t st;
     for (int i = 1; i <= ticks; ++i) {
-        odo_truck_step(&t, &m, (uint32_t)(i * dl), (uint32_t)(i * dr), 32U, &st);
+        odo_truck_step(&t, &m, (uint32_t)(i * dl), (uint32_t)(i * dr), 32U, 1U, &st);
     }
     const double r = u / dth, th = ticks * dth; /* exact circle through the origin, heading +x */
     return hypot(MM_Q32(t.pose.x_mm_q32) - r * sin(th), MM_Q32(t.pose.y_mm_q32) - r * (1.0 - cos(th)));
@@ -169,7 +169,7 @@ static void unequal_wheels_are_corrected_per_eq_6_35(void)
     const odo_model_t m = model_of(&tp, 24U, ODO_HEADING_MIDPOINT);
     odo_truck_t t = truck_at_origin(&m, 0U, 0U, 24U);
     odo_step_t st;
-    odo_truck_step(&t, &m, 1000U, 1000U, 24U, &st);
+    odo_truck_step(&t, &m, 1000U, 1000U, 24U, 1U, &st);
     const double ed = tp.ed_q30 / 1073741824.0;
     const double want = 1000.0 * cm_mm(&tp) * (2.0 / (1.0 / ed + 1.0) - 2.0 / (ed + 1.0)) / 340.0;
     TEST_ASSERT_TRUE(st.dturn_q64 > 0);
@@ -184,16 +184,16 @@ static void implausible_counter_jump_is_flagged_not_integrated(void)
     const odo_model_t m = model_of(&tp, 24U, ODO_HEADING_MIDPOINT);
     odo_truck_t t = truck_at_origin(&m, 100U, 100U, 24U);
     odo_step_t st;
-    odo_truck_step(&t, &m, 100U + m.max_counts, 100U, 24U, &st); /* exactly at the limit: fine */
+    odo_truck_step(&t, &m, 100U + m.max_counts, 100U, 24U, 1U, &st); /* exactly at the limit: fine */
     TEST_ASSERT_FALSE(st.jump);
     const odo_pose_t before = t.pose;
     const uint32_t base = 100U + m.max_counts;
-    odo_truck_step(&t, &m, base + m.max_counts + 1U, 100U, 24U, &st); /* one count too many */
+    odo_truck_step(&t, &m, base + m.max_counts + 1U, 100U, 24U, 1U, &st); /* one count too many */
     TEST_ASSERT_TRUE(st.jump);
     TEST_ASSERT_EQUAL_INT64(before.x_mm_q32, t.pose.x_mm_q32);
     TEST_ASSERT_EQUAL_UINT64(before.heading_q64, t.pose.heading_q64);
     /* the next tick integrates from the re-taken baseline */
-    odo_truck_step(&t, &m, base + m.max_counts + 11U, 110U, 24U, &st);
+    odo_truck_step(&t, &m, base + m.max_counts + 11U, 110U, 24U, 1U, &st);
     TEST_ASSERT_FALSE(st.jump);
     TEST_ASSERT_EQUAL_INT32(10, st.delta[0]);
     TEST_ASSERT_EQUAL_INT32(10, st.delta[1]);
@@ -206,7 +206,7 @@ static void inverted_encoders_count_forward(void)
     const odo_model_t m = model_of(&tp, 16U, ODO_HEADING_MIDPOINT);
     odo_truck_t t = truck_at_origin(&m, 5U, 5U, 16U);
     odo_step_t st;
-    odo_truck_step(&t, &m, ts_wrap_counter(5 - 400, 16U), 405U, 16U, &st);
+    odo_truck_step(&t, &m, ts_wrap_counter(5 - 400, 16U), 405U, 16U, 1U, &st);
     TEST_ASSERT_EQUAL_INT32(400, st.delta[0]);
     TEST_ASSERT_EQUAL_INT32(400, st.delta[1]);
     TEST_ASSERT_EQUAL_INT64(0, st.dturn_q64);
@@ -226,6 +226,112 @@ static void parameters_that_cannot_be_represented_are_refused(void)
     TEST_ASSERT_EQUAL(ODO_MODEL_ERR_RANGE, odo_model_init(&m, &tp, 24U, 0U, 40000U, 3000U));
 }
 
+/// Lost samples: the limit is max_counts per tick elapsed, as long as the counter width can tell
+/// that many counts apart (max_counts * ticks < 2^(w-1)).
+static void the_plausibility_limit_scales_with_the_ticks_elapsed(void)
+{
+    const odo_truck_params_t tp = labmate();
+    const odo_model_t m = model_of(&tp, 24U, ODO_HEADING_MIDPOINT);
+    odo_truck_t t = truck_at_origin(&m, 0U, 0U, 24U);
+    odo_step_t st;
+    const uint32_t three = 3U * m.max_counts;
+    odo_truck_step(&t, &m, three, three, 24U, 3U, &st);
+    TEST_ASSERT_FALSE(st.jump);
+    TEST_ASSERT_EQUAL_INT32((int32_t)three, st.delta[0]);
+    odo_truck_step(&t, &m, three + 2U * m.max_counts + 1U, three, 24U, 2U, &st); /* one too many */
+    TEST_ASSERT_TRUE(st.jump);
+    odo_truck_step(&t, &m, three + 2U * m.max_counts + 1U, three, 24U, 0U, &st); /* 0 counts as 1 */
+    TEST_ASSERT_FALSE(st.jump);
+    /* 24 bits tell 844 ticks at 9933 counts (2^23 / 9933 = 844.5); 845 are ambiguous */
+    const uint32_t horizon = (uint32_t)((1UL << 23) / m.max_counts);
+    odo_truck_step(&t, &m, 0U, 0U, 24U, horizon, &st);
+    TEST_ASSERT_FALSE(st.jump);
+    odo_truck_step(&t, &m, 0U, 0U, 24U, horizon + 1U, &st);
+    TEST_ASSERT_TRUE(st.jump);
+    odo_truck_step(&t, &m, 5U, 5U, 0U, 1U, &st); /* a reading of no bits tells nothing */
+    TEST_ASSERT_TRUE(st.jump);
+    TEST_ASSERT_EQUAL_INT32(0, odo_count_delta(7U, 9U, 0U));
+    TEST_ASSERT_EQUAL_INT32(2, odo_count_delta(7U, 9U, 200U));
+}
+
+/// A step over several ticks of a constant-curvature arc (000 Eqs. 2.2-2.6 with the midpoint
+/// heading) lands on the arc: its length is taken as the chord, U sinc(dtheta/2), not U, whose
+/// overshoot grows with the cube of the gap. 6 ticks of a 0.5 m radius at 1 m/s: 2.3 mm.
+static void a_multi_tick_step_follows_the_arc(void)
+{
+    const odo_truck_params_t tp = labmate();
+    const odo_model_t m = model_of(&tp, 24U, ODO_HEADING_MIDPOINT);
+    const double k = cm_mm(&tp), b = 340.0, r_mm = 500.0, v = 1000.0;
+    const int32_t dl = (int32_t)llround(v * (1.0 - b / (2.0 * r_mm)) * 0.04 / k);
+    const int32_t dr = (int32_t)llround(v * (1.0 + b / (2.0 * r_mm)) * 0.04 / k);
+    odo_truck_t t = truck_at_origin(&m, 0U, 0U, 24U);
+    odo_step_t st;
+    odo_truck_step(&t, &m, (uint32_t)(6 * dl), (uint32_t)(6 * dr), 24U, 6U, &st);
+    TEST_ASSERT_FALSE(st.jump);
+    /* the exact arc through the same counts, in double precision */
+    const double u = 6.0 * k * (dl + dr) / 2.0, th = 6.0 * k * (dr - dl) / b;
+    const double chord = u * sin(th / 2.0) / (th / 2.0);
+    TEST_ASSERT_DOUBLE_WITHIN(0.005, chord * cos(th / 2.0), MM_Q32(t.pose.x_mm_q32));
+    TEST_ASSERT_DOUBLE_WITHIN(0.005, chord * sin(th / 2.0), MM_Q32(t.pose.y_mm_q32));
+    TEST_ASSERT_TRUE(u - chord > 2.0); /* what the step would have overshot */
+    TEST_ASSERT_DOUBLE_WITHIN(1e-9, th, TURNS_Q64_TO_RAD(t.pose.heading_q64));
+    /* per tick (ticks == 1) the step stays U along the midpoint, as the double reference has it */
+    odo_truck_t t1 = truck_at_origin(&m, 0U, 0U, 24U);
+    odo_truck_step(&t1, &m, (uint32_t)dl, (uint32_t)dr, 24U, 1U, &st);
+    const double u1 = k * (dl + dr) / 2.0, th1 = k * (dr - dl) / b;
+    TEST_ASSERT_DOUBLE_WITHIN(1e-6, u1 * cos(th1 / 2.0), MM_Q32(t1.pose.x_mm_q32));
+}
+
+/// A step over a long gap is bounded by what int64 mm Q40 can sum: a coarse encoder (100 counts
+/// per turn of a 477 mm wheel, 15 mm a count) with 32-bit counters can tell 100,000 ticks apart,
+/// but 200,000 counts would be 3,000 km, 2^62.5 per wheel in Q40: flagged, never overflowed.
+static void a_step_too_large_to_integrate_is_flagged(void)
+{
+    odo_truck_params_t tp = labmate();
+    tp.wheel_diameter_nm = 477000000U;
+    tp.counts_per_rev_milli = 100000U;
+    const odo_model_t m = model_of(&tp, 32U, ODO_HEADING_MIDPOINT);
+    TEST_ASSERT_TRUE(m.max_delta_counts >= m.max_counts);
+    TEST_ASSERT_TRUE(m.max_delta_counts < 200000U);
+    TEST_ASSERT_TRUE((uint64_t)m.max_counts * 100000U > 200000U);
+    odo_truck_t t = truck_at_origin(&m, 0U, 0U, 32U);
+    odo_step_t st;
+    odo_truck_step(&t, &m, 200000U, 200000U, 32U, 100000U, &st);
+    TEST_ASSERT_TRUE(st.jump);
+    TEST_ASSERT_EQUAL_INT64(0, t.pose.x_mm_q32);
+    odo_truck_step(&t, &m, 200000U + m.max_delta_counts, 200000U + m.max_delta_counts, 32U, 100000U, &st);
+    TEST_ASSERT_FALSE(st.jump);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-6 * m.max_delta_counts * cm_mm(&tp), m.max_delta_counts * cm_mm(&tp),
+                              MM_Q32(t.pose.x_mm_q32));
+}
+
+/// Beyond ODO_POSE_LIMIT_MM_Q32 the pose is held (int64 overflowed 2^31 mm out before).
+static void a_pose_beyond_the_limit_is_held(void)
+{
+    const odo_truck_params_t tp = labmate();
+    const odo_model_t m = model_of(&tp, 24U, ODO_HEADING_MIDPOINT);
+    odo_truck_t t;
+    const odo_pose_t far = {INT64_MAX - 5, INT64_MIN + 5, 0U};
+    odo_truck_reset(&t, &far);
+    odo_step_t st;
+    odo_truck_step(&t, &m, 0U, 0U, 24U, 1U, &st);
+    odo_truck_step(&t, &m, 9000U, 9000U, 24U, 1U, &st);
+    TEST_ASSERT_TRUE(st.range);
+    TEST_ASSERT_FALSE(st.jump);
+    TEST_ASSERT_EQUAL_INT64(INT64_MAX - 5, t.pose.x_mm_q32);
+    TEST_ASSERT_FALSE(odo_pose_in_range(&t.pose));
+    const odo_pose_t edge = {ODO_POSE_LIMIT_MM_Q32 - 1, -(ODO_POSE_LIMIT_MM_Q32 - 1), 0U};
+    TEST_ASSERT_TRUE(odo_pose_in_range(&edge));
+    const odo_pose_t low = {-ODO_POSE_LIMIT_MM_Q32, -ODO_POSE_LIMIT_MM_Q32, 0U}; /* [-L, L) */
+    TEST_ASSERT_TRUE(odo_pose_in_range(&low));
+    const odo_pose_t out_y = {0, -ODO_POSE_LIMIT_MM_Q32 - 1, 0U};
+    TEST_ASSERT_FALSE(odo_pose_in_range(&out_y));
+    const odo_pose_t out_x = {ODO_POSE_LIMIT_MM_Q32, 0, 0U};
+    TEST_ASSERT_FALSE(odo_pose_in_range(&out_x));
+    const odo_pose_t far_y = {0, INT64_MAX, 0U};
+    TEST_ASSERT_FALSE(odo_pose_in_range(&far_y));
+}
+
 /* ---------------------------------------------------------------------------------------------
  * Tyre scrub (odo_odometry.h): dtheta = dtheta(Eq. 2.4) * (1 - k m / v).
  * ------------------------------------------------------------------------------------------- */
@@ -241,9 +347,9 @@ static void drive_pair(const odo_model_t *a, const odo_model_t *b, const int32_t
     for (int i = 0; i < n; ++i) {
         c[0] += d[i][0];
         c[1] += d[i][1];
-        odo_truck_step(ta, a, ts_wrap_counter(c[0], bits), ts_wrap_counter(c[1], bits), bits, &st);
+        odo_truck_step(ta, a, ts_wrap_counter(c[0], bits), ts_wrap_counter(c[1], bits), bits, 1U, &st);
         TEST_ASSERT_FALSE(st.jump);
-        odo_truck_step(tb, b, ts_wrap_counter(c[0], bits), ts_wrap_counter(c[1], bits), bits, &st);
+        odo_truck_step(tb, b, ts_wrap_counter(c[0], bits), ts_wrap_counter(c[1], bits), bits, 1U, &st);
         TEST_ASSERT_FALSE(st.jump);
     }
 }
@@ -276,7 +382,7 @@ static void spot_turn_is_unchanged_by_scrub(void)
     const odo_model_t mk = model_of(&tk, 24U, ODO_HEADING_MIDPOINT);
     odo_truck_t t = truck_at_origin(&mk, 0U, 0U, 24U);
     odo_step_t st;
-    odo_truck_step(&t, &mk, ts_wrap_counter(-500, 24U), 500U, 24U, &st);
+    odo_truck_step(&t, &mk, ts_wrap_counter(-500, 24U), 500U, 24U, 1U, &st);
     TEST_ASSERT_DOUBLE_WITHIN(1e-12, 1000.0 * cm_mm(&tk) / (340.0 * (tk.eb_q30 / 1073741824.0)),
                               TURNS_Q64_TO_RAD(t.pose.heading_q64));
 }
@@ -306,8 +412,8 @@ static void arc_of_known_radius_gets_the_predicted_factor(void)
         const odo_model_t m0 = model_of(&tp, 32U, ODO_HEADING_MIDPOINT), mk = model_of(&tk, 32U, ODO_HEADING_MIDPOINT);
         odo_step_t s0, sk;
         odo_truck_t a = truck_at_origin(&m0, 0U, 0U, 32U), b = truck_at_origin(&mk, 0U, 0U, 32U);
-        odo_truck_step(&a, &m0, (uint32_t)arcs[i].dl, (uint32_t)arcs[i].dr, 32U, &s0);
-        odo_truck_step(&b, &mk, (uint32_t)arcs[i].dl, (uint32_t)arcs[i].dr, 32U, &sk);
+        odo_truck_step(&a, &m0, (uint32_t)arcs[i].dl, (uint32_t)arcs[i].dr, 32U, 1U, &s0);
+        odo_truck_step(&b, &mk, (uint32_t)arcs[i].dl, (uint32_t)arcs[i].dr, 32U, 1U, &sk);
         const double al = fabs((double)arcs[i].dl), ar = fabs((double)arcs[i].dr);
         const double g = 1.0 - (tk.scrub_q30 / 1073741824.0) * 2.0 * fmin(al, ar) / (al + ar);
         char msg[64];
@@ -330,8 +436,8 @@ static void arc_of_known_radius_gets_the_predicted_factor(void)
     const odo_model_t m0 = model_of(&tp, 24U, ODO_HEADING_MIDPOINT), mk = model_of(&tk, 24U, ODO_HEADING_MIDPOINT);
     odo_truck_t a = truck_at_origin(&m0, 0U, 0U, 24U), b = truck_at_origin(&mk, 0U, 0U, 24U);
     odo_step_t s0, sk;
-    odo_truck_step(&a, &m0, 1000U, 1000U, 24U, &s0);
-    odo_truck_step(&b, &mk, 1000U, 1000U, 24U, &sk);
+    odo_truck_step(&a, &m0, 1000U, 1000U, 24U, 1U, &s0);
+    odo_truck_step(&b, &mk, 1000U, 1000U, 24U, 1U, &sk);
     TEST_ASSERT_TRUE(s0.dturn_q64 > 0);
     /* k dtheta comes from k-scaled per-count multipliers, each rounded to half a Q64 LSB: 2000
      * counts give at most 1000 LSB (5e-17 rad) */
@@ -359,7 +465,7 @@ static void zero_scrub_is_bit_identical_to_plain_eq_2_4(void)
         }
         odo_pose_t before = t.pose;
         odo_step_t st;
-        odo_truck_step(&t, &m, ts_wrap_counter(c[0], 24U), ts_wrap_counter(c[1], 24U), 24U, &st);
+        odo_truck_step(&t, &m, ts_wrap_counter(c[0], 24U), ts_wrap_counter(c[1], 24U), 24U, 1U, &st);
         const uint64_t want = m.turn_q64[1] * (uint64_t)(int64_t)d[1] - m.turn_q64[0] * (uint64_t)(int64_t)d[0];
         TEST_ASSERT_EQUAL_UINT64(want, (uint64_t)st.dturn_q64);
         TEST_ASSERT_EQUAL_UINT64(before.heading_q64 + want, t.pose.heading_q64);
@@ -383,8 +489,8 @@ static void scrub_factor_error_is_below_2e_minus_32_on_random_ticks(void)
         const int32_t dr = sign * (int32_t)ts_rng_range(&rng, 1, (int64_t)m0.max_counts);
         odo_truck_t a = truck_at_origin(&m0, 0U, 0U, 32U), b = truck_at_origin(&mk, 0U, 0U, 32U);
         odo_step_t s0, sk;
-        odo_truck_step(&a, &m0, (uint32_t)dl, (uint32_t)dr, 32U, &s0);
-        odo_truck_step(&b, &mk, (uint32_t)dl, (uint32_t)dr, 32U, &sk);
+        odo_truck_step(&a, &m0, (uint32_t)dl, (uint32_t)dr, 32U, 1U, &s0);
+        odo_truck_step(&b, &mk, (uint32_t)dl, (uint32_t)dr, 32U, 1U, &sk);
         if (s0.dturn_q64 == 0) {
             continue;
         }
@@ -452,7 +558,7 @@ static void narrow_counters_wrap_both_ways_without_losing_counts(void)
         int wraps = 0;
         for (int k = 0; k < 400; ++k) { /* forward: up through the wrap, many times */
             c += cases[i].per_tick;
-            odo_truck_step(&t, &m, ts_wrap_counter(c, bits), ts_wrap_counter(c, bits), bits, &st);
+            odo_truck_step(&t, &m, ts_wrap_counter(c, bits), ts_wrap_counter(c, bits), bits, 1U, &st);
             TEST_ASSERT_FALSE(st.jump);
             TEST_ASSERT_EQUAL_INT32(cases[i].per_tick, st.delta[0]);
             wraps += (ts_wrap_counter(c, bits) < ts_wrap_counter(c - cases[i].per_tick, bits)) ? 1 : 0;
@@ -461,7 +567,7 @@ static void narrow_counters_wrap_both_ways_without_losing_counts(void)
         TEST_ASSERT_DOUBLE_WITHIN(1e-6, 400.0 * cases[i].per_tick * cm_mm(&tp), MM_Q32(t.pose.x_mm_q32));
         for (int k = 0; k < 400; ++k) { /* and back down through it */
             c -= cases[i].per_tick;
-            odo_truck_step(&t, &m, ts_wrap_counter(c, bits), ts_wrap_counter(c, bits), bits, &st);
+            odo_truck_step(&t, &m, ts_wrap_counter(c, bits), ts_wrap_counter(c, bits), bits, 1U, &st);
             TEST_ASSERT_FALSE(st.jump);
             TEST_ASSERT_EQUAL_INT32(-cases[i].per_tick, st.delta[1]);
         }
@@ -494,6 +600,10 @@ int main(void)
     RUN_TEST(implausible_counter_jump_is_flagged_not_integrated);
     RUN_TEST(inverted_encoders_count_forward);
     RUN_TEST(parameters_that_cannot_be_represented_are_refused);
+    RUN_TEST(the_plausibility_limit_scales_with_the_ticks_elapsed);
+    RUN_TEST(a_multi_tick_step_follows_the_arc);
+    RUN_TEST(a_step_too_large_to_integrate_is_flagged);
+    RUN_TEST(a_pose_beyond_the_limit_is_held);
     RUN_TEST(spot_turn_is_unchanged_by_scrub);
     RUN_TEST(arc_of_known_radius_gets_the_predicted_factor);
     RUN_TEST(zero_scrub_is_bit_identical_to_plain_eq_2_4);

@@ -3,6 +3,7 @@
 
 #include <errno.h>
 #include <math.h>
+#include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -93,9 +94,18 @@ int returns_read(const char *path, returns_t *r, char *err, size_t errlen)
             errno = 0;
             end = NULL;
             v[k] = strtod(field[2 + k], &end);
+            const bool angle = k == 2 || k == 5;
+            const double lim = angle ? RETURNS_MAX_ABS_DEG : RETURNS_MAX_ABS_MM;
             if (end == field[2 + k] || *end != '\0' || errno == ERANGE || !isfinite(v[k])) {
                 snprintf(err, errlen, "%s:%u: field %d (%s): '%s' is not a finite number", path, lineno, 3 + k,
                          k_cols[2 + k], field[2 + k]);
+                rc = -1;
+            } else if (fabs(v[k]) > lim) {
+                /* Beyond it the difference of two such values loses the resolution the
+                 * calibration works in (1 um, 1 micro-degree); 1e308 deg came out as 0. */
+                snprintf(err, errlen, "%s:%u: field %d (%s): '%s' is beyond +-%.0e %s: not a %s", path, lineno,
+                         3 + k, k_cols[2 + k], field[2 + k], lim, angle ? "deg" : "mm",
+                         angle ? "heading" : "return position");
                 rc = -1;
             }
         }

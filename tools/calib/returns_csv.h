@@ -4,7 +4,9 @@
 ///   1,cw,228.572,200.071,-6.3801,-0.001,-0.120,-0.0020
 ///
 /// The header must be exactly that line. direction is cw or ccw (a straight experiment's "fwd"
-/// is refused: UMBmark needs the square). Every number must be finite; blank lines and lines
+/// is refused: UMBmark needs the square). Every number must be finite, positions within
+/// +-RETURNS_MAX_ABS_MM and headings within +-RETURNS_MAX_ABS_DEG (beyond, the difference of two
+/// of them loses the micrometre / micro-degree the calibration works in); blank lines and lines
 /// starting with '#' are skipped. Errors name the file and line: "returns.csv:7: field 4
 /// (y_abs_mm): 'nan' is not a finite number".
 #ifndef CALIB_RETURNS_CSV_H
@@ -15,6 +17,8 @@
 #include "odo/odo_umbmark.h"
 
 #define RETURNS_MAX_RUNS ODO_UMB_MAX_RUNS
+#define RETURNS_MAX_ABS_MM  1e9 ///< |x|, |y| (1000 km): doubles keep 1e-7 mm there
+#define RETURNS_MAX_ABS_DEG 1e6 ///< |theta| (2778 turns): doubles keep 1e-10 deg there
 
 typedef struct {
     size_t n[2];                                  ///< cw, ccw

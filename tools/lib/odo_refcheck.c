@@ -28,7 +28,7 @@ int odo_refcheck_run(uint64_t seed, uint8_t bits, uint8_t heading_form,
     int64_t count[2] = {(int64_t)mask - 5000, (int64_t)mask - 12345}; /* wrap early */
     odo_step_t st;
     odo_truck_step(&t, &m, (uint32_t)((uint64_t)count[0] & mask), (uint32_t)((uint64_t)count[1] & mask),
-                   bits, &st);
+                   bits, 1U, &st);
     out->max_pos_err_mm = 0.0;
     out->ticks = 0U;
     out->wraps = 0U;
@@ -43,7 +43,7 @@ int odo_refcheck_run(uint64_t seed, uint8_t bits, uint8_t heading_form,
             }
         }
         odo_truck_step(&t, &m, (uint32_t)((uint64_t)count[0] & mask),
-                       (uint32_t)((uint64_t)count[1] & mask), bits, &st);
+                       (uint32_t)((uint64_t)count[1] & mask), bits, 1U, &st);
         odo_ref_step(&r, d[0], d[1]);
         out->ticks++;
         const double ex = (double)t.pose.x_mm_q32 / 4294967296.0 - r.x_mm;

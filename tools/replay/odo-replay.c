@@ -19,6 +19,8 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <jansson.h>
+
 #include "hal_log.h"
 #include "hal_socketcan.h"
 #include "odo/odo_can.h"
@@ -84,12 +86,16 @@ static void on_tick(void *user, replay_t *r, uint64_t tick, const odo_tick_input
         s->out_frames++;
     }
     const odo_pose_t *a = &out->pose[ODO_TRUCK_A], *b = &out->pose[ODO_TRUCK_B];
+    /* t_s: the tick's time on the log's clock relative to the first tick (steps back after a
+     * clock step, jumps over a skipped gap; replay.h). */
+    const double t_s = in->t_us >= r->origin_us ? (double)(in->t_us - r->origin_us) / 1e6
+                                                : -(double)(r->origin_us - in->t_us) / 1e6;
     fprintf(s->csv, "%" PRIu64 ",%.6f,%.6f,%.6f,%.9f,%.6f,%.6f,%.9f,%" PRId32 ",%" PRId32 ",0x%05" PRIX32 "\n",
-            tick, (double)(tick * r->tick_us) / 1e6, q32_mm(a->x_mm_q32), q32_mm(a->y_mm_q32),
+            tick, t_s, q32_mm(a->x_mm_q32), q32_mm(a->y_mm_q32),
             q64_deg(a->heading_q64), q32_mm(b->x_mm_q32), q32_mm(b->y_mm_q32), q64_deg(b->heading_q64),
             out->ipec_dtheta_bam[0], out->ipec_dtheta_bam[1], out->faults);
     if (!s->quiet && tick > 0U && tick % PROGRESS_TICKS == 0U) {
-        fprintf(stderr, "odo-replay: %" PRIu64 " ticks (%.0f s of log)\n", tick, (double)tick * r->tick_us / 1e6);
+        fprintf(stderr, "odo-replay: %" PRIu64 " ticks (%.0f s of log)\n", tick, t_s);
     }
 }
 
@@ -155,29 +161,93 @@ static FILE *open_in(const char *dir, const char *name)
     return fopen(path, "w");
 }
 
-static void write_summary(FILE *f, const char *mode, const char *input, const replay_t *r,
-                          const hal_log_stats_t *ls, const hal_sc_stats_t *ss, const sink_t *s)
+/// A JSON string for any bytes: jansson refuses invalid UTF-8, so such a path is written with '?'
+/// for every byte above 0x7F (the summary stays valid JSON; the file names the input anyway).
+static json_t *json_path(const char *s)
+{
+    json_t *j = json_string(s);
+    if (j != NULL) {
+        return j;
+    }
+    char buf[PATH_MAX];
+    snprintf(buf, sizeof buf, "%s", s);
+    for (char *c = buf; *c != '\0'; ++c) {
+        if ((unsigned char)*c > 0x7FU) {
+            *c = '?';
+        }
+    }
+    return json_string(buf);
+}
+
+static int set_u64(json_t *o, const char *key, uint64_t v)
+{
+    return json_object_set_new(o, key, json_integer(v > (uint64_t)INT64_MAX ? INT64_MAX : (json_int_t)v));
+}
+
+/// summary.json, built with jansson so every string is escaped. Returns 0, or -1 on a write error.
+static int write_summary(FILE *f, const char *mode, const char *input, const replay_t *r,
+                         const hal_log_stats_t *ls, const hal_sc_stats_t *ss, const sink_t *s)
 {
     const replay_stats_t *st = &r->stats;
-    fprintf(f, "{\"tool\": \"odo-replay\", \"mode\": \"%s\", \"input\": \"%s\", \"ticks\": %" PRIu64
-               ", \"frames\": %" PRIu64 ", \"sensor_frames\": %" PRIu64 ", \"ignored\": %" PRIu64
-               ", \"bad_dlc\": %" PRIu64 ", \"error_frames\": %" PRIu64 ", \"bus_off\": %" PRIu64
-               ", \"time_backwards\": %" PRIu64 ", \"late\": %" PRIu64 ", \"dup_dropped\": %" PRIu64
-               ", \"out_frames\": %" PRIu64 ", \"tx_dropped\": %" PRIu32 ", \"params_status\": \"%s\"",
-            mode, input, st->ticks, st->frames, st->sensor_frames, st->ignored, st->bad_dlc,
-            st->error_frames, st->bus_off, st->time_backwards, st->late, st->dup_dropped, s->out_frames,
-            r->app.tx_dropped, odo_params_status_str(r->app.params_status));
+    json_t *o = json_object();
+    int bad = o == NULL;
+    bad |= json_object_set_new(o, "tool", json_string("odo-replay"));
+    bad |= json_object_set_new(o, "mode", json_string(mode));
+    bad |= json_object_set_new(o, "input", json_path(input));
+    bad |= set_u64(o, "ticks", st->ticks);
+    bad |= set_u64(o, "frames", st->frames);
+    bad |= set_u64(o, "sensor_frames", st->sensor_frames);
+    bad |= set_u64(o, "ignored", st->ignored);
+    bad |= set_u64(o, "bad_dlc", st->bad_dlc);
+    bad |= set_u64(o, "error_frames", st->error_frames);
+    bad |= set_u64(o, "bus_off", st->bus_off);
+    bad |= set_u64(o, "time_backwards", st->time_backwards);
+    bad |= set_u64(o, "clock_steps", st->clock_steps);
+    bad |= set_u64(o, "gaps_skipped", st->gaps);
+    bad |= json_object_set_new(o, "gap_skipped_s", json_real((double)st->gap_us / 1e6));
+    bad |= json_object_set_new(o, "longest_gap_s", json_real((double)st->longest_gap_us / 1e6));
+    bad |= set_u64(o, "late", st->late);
+    bad |= set_u64(o, "dup_dropped", st->dup_dropped);
+    bad |= set_u64(o, "out_frames", s->out_frames);
+    bad |= set_u64(o, "tx_dropped", r->app.tx_dropped);
+    bad |= json_object_set_new(o, "params_status", json_string(odo_params_status_str(r->app.params_status)));
     if (ls != NULL) {
-        fprintf(f, ", \"log_lines\": %" PRIu64 ", \"log_blank\": %" PRIu64, ls->lines, ls->blank);
+        bad |= set_u64(o, "log_lines", ls->lines);
+        bad |= set_u64(o, "log_blank", ls->blank);
     }
     if (ss != NULL) {
-        fprintf(f, ", \"bus\": {\"rx_frames\": %" PRIu64 ", \"rx_dropped\": %" PRIu64 ", \"tx_frames\": %" PRIu64
-                   ", \"tx_retries\": %" PRIu64 ", \"tx_dropped\": %" PRIu64 ", \"down_events\": %" PRIu64
-                   ", \"reopens\": %" PRIu64 "}",
-                ss->rx_frames, ss->rx_dropped, ss->tx_frames, ss->tx_retries, ss->tx_dropped, ss->down_events,
-                ss->reopens);
+        json_t *b = json_object();
+        bad |= b == NULL;
+        bad |= set_u64(b, "rx_frames", ss->rx_frames);
+        bad |= set_u64(b, "rx_dropped", ss->rx_dropped);
+        bad |= set_u64(b, "tx_frames", ss->tx_frames);
+        bad |= set_u64(b, "tx_retries", ss->tx_retries);
+        bad |= set_u64(b, "tx_dropped", ss->tx_dropped);
+        bad |= set_u64(b, "down_events", ss->down_events);
+        bad |= set_u64(b, "reopens", ss->reopens);
+        bad |= json_object_set_new(o, "bus", b);
     }
-    fprintf(f, "}\n");
+    bad |= json_dumpf(o, f, JSON_REAL_PRECISION(12)) != 0; /* one line, as before */
+    bad |= fputc('\n', f) == EOF;
+    json_decref(o);
+    return bad ? -1 : 0;
+}
+
+/// Report gaps as replay_push skips them, --quiet or not: the output has a hole there (at most
+/// GAP_REPORTS lines; the summary counts all).
+#define GAP_REPORTS 10U
+static void report_gaps(const replay_t *r, uint64_t *seen, const char *where)
+{
+    if (r->stats.gaps == *seen) {
+        return;
+    }
+    *seen = r->stats.gaps;
+    if (*seen > GAP_REPORTS) {
+        return;
+    }
+    fprintf(stderr, "odo-replay: %s: a gap of %.6g s in the frames (more than %u ticks): skipped, not stepped "
+                    "through%s\n", where, (double)r->stats.last_gap_us / 1e6, REPLAY_MAX_GAP_TICKS,
+            *seen == GAP_REPORTS ? " (further gaps only in summary.json)" : "");
 }
 
 /// Push every frame waiting on the socket. Returns 0, or 1 on a socket error (reported).
@@ -219,7 +289,7 @@ static int run_live(hal_socketcan_t *sc, replay_t *r, double idle_exit_s, uint64
         fprintf(stderr, "odo-replay: listening on %s\n", sc->ifname);
     }
     bool seen = false, down = false;
-    uint64_t last_frame_us = hal_socketcan_now_us(), last_check_us = 0U;
+    uint64_t last_frame_us = hal_socketcan_now_us(), last_check_us = 0U, gaps_seen = 0U;
     while (!g_stop) {
         uint64_t deadline = 0U;
         const bool open_tick = replay_deadline_us(r, margin_us, &deadline);
@@ -236,6 +306,7 @@ static int run_live(hal_socketcan_t *sc, replay_t *r, double idle_exit_s, uint64
         if (drain(sc, r, &seen, &last_frame_us, &down, quiet) != 0) {
             return 1;
         }
+        report_gaps(r, &gaps_seen, sc->ifname);
         now = hal_socketcan_now_us();
         if (replay_deadline_us(r, margin_us, &deadline) && now >= deadline) {
             /* Frames queued while we looked at the clock were stamped before it: take them first. */
@@ -371,6 +442,15 @@ int main(int argc, char **argv)
     if (sink.csv == NULL || sink.log == NULL) {
         fprintf(stderr, "odo-replay: cannot create outputs in %s: %s\n", out != NULL ? tmp : "/dev/null",
                 strerror(errno));
+        if (sink.csv != NULL) {
+            fclose(sink.csv);
+        }
+        if (sink.log != NULL) {
+            fclose(sink.log);
+        }
+        if (out != NULL) {
+            remove_flat_dir(tmp); /* ours: nothing half-written stays behind */
+        }
         return 1;
     }
     static char csv_buf[1 << 16], log_buf[1 << 16];
@@ -390,12 +470,18 @@ int main(int argc, char **argv)
         candump_line_t l;
         hal_log_status_t st;
         bool iface_set = out_iface != NULL;
+        uint64_t gaps_seen = 0U;
         while ((st = hal_log_next(&reader, &l)) == HAL_LOG_FRAME) {
             if (!iface_set) {
                 snprintf(sink.iface, sizeof sink.iface, "%s", l.iface);
                 iface_set = true;
             }
             replay_push(&r, &l.frame, l.t_us);
+            if (r.stats.gaps != gaps_seen) {
+                char where[PATH_MAX + 32];
+                snprintf(where, sizeof where, "%s:%" PRIu64, log, reader.line_no);
+                report_gaps(&r, &gaps_seen, where);
+            }
         }
         if (st == HAL_LOG_ERROR) {
             fprintf(stderr, "odo-replay: %s\n", reader.err);
@@ -410,6 +496,15 @@ int main(int argc, char **argv)
         fprintf(stderr, "odo-replay: warning: %" PRIu64 " frames stamped before the previous frame "
                         "(flagged TIME_BACKWARDS)\n", r.stats.time_backwards);
     }
+    if (r.stats.clock_steps > 0U && !quiet) {
+        fprintf(stderr, "odo-replay: warning: the clock stepped back %" PRIu64 " time(s) by more than %u ticks; "
+                        "the tick clock was re-anchored each time\n", r.stats.clock_steps, REPLAY_CLOCK_STEP_TICKS);
+    }
+    if (r.stats.gaps > 0U) { /* reported even with --quiet: the output has a hole */
+        fprintf(stderr, "odo-replay: warning: %" PRIu64 " gap(s) longer than %u ticks skipped, %.6g s in all "
+                        "(longest %.6g s)\n", r.stats.gaps, REPLAY_MAX_GAP_TICKS, (double)r.stats.gap_us / 1e6,
+                (double)r.stats.longest_gap_us / 1e6);
+    }
     if (r.stats.ignored > 0U && !quiet) {
         fprintf(stderr, "odo-replay: %" PRIu64 " frames not consumed (unknown ID, RTR, extended or output "
                         "frames) ignored\n", r.stats.ignored);
@@ -418,11 +513,12 @@ int main(int argc, char **argv)
     if (out != NULL) {
         FILE *sf = open_in(tmp, "summary.json");
         FILE *mk = open_in(tmp, MARKER);
+        int sum_bad = 0;
         if (sf != NULL) {
-            write_summary(sf, log != NULL ? "offline" : "live", log != NULL ? log : iface, &r,
-                          log != NULL ? &reader.stats : NULL, iface != NULL ? &sc.stats : NULL, &sink);
+            sum_bad = write_summary(sf, log != NULL ? "offline" : "live", log != NULL ? log : iface, &r,
+                                    log != NULL ? &reader.stats : NULL, iface != NULL ? &sc.stats : NULL, &sink);
         }
-        const int bad = sf == NULL || mk == NULL || fclose(sf) != 0 || fclose(mk) != 0;
+        const int bad = sf == NULL || mk == NULL || sum_bad != 0 || fclose(sf) != 0 || fclose(mk) != 0;
         const int bad2 = fclose(sink.csv) != 0 || fclose(sink.log) != 0 || sink.io_error;
         if (rc == 0 && (bad || bad2)) {
             fprintf(stderr, "odo-replay: writing %s failed: %s\n", tmp, strerror(errno));

@@ -19,9 +19,15 @@ odo_params_status_t replay_init(replay_t *r, const odo_params_t *p, replay_tick_
     return st;
 }
 
+/// Time of tick k (>= anchor_tick) on the log's clock.
+static uint64_t tick_time(const replay_t *r, uint64_t k)
+{
+    return r->anchor_us + (k - r->anchor_tick) * (uint64_t)r->tick_us;
+}
+
 static void step(replay_t *r)
 {
-    r->in.t_us = r->origin_us + r->cur * (uint64_t)r->tick_us;
+    r->in.t_us = tick_time(r, r->cur);
     odo_app_step(&r->app, &r->in, &r->out);
     r->stats.ticks++;
     if (r->fn != NULL) {
@@ -46,7 +52,34 @@ bool replay_deadline_us(const replay_t *r, uint64_t margin_us, uint64_t *deadlin
     if (!r->have_origin || !r->pending) {
         return false;
     }
-    *deadline_us = r->origin_us + r->cur * (uint64_t)r->tick_us + r->tick_us / 2U + margin_us;
+    *deadline_us = tick_time(r, r->cur) + r->tick_us / 2U + margin_us;
+    return true;
+}
+
+/// The four consumed frames by identifier (what odo_can_classify would say, without its table
+/// walk: this runs for every frame of a replay); ODO_CAN_MSG_UNKNOWN for anything else.
+static odo_can_msg_t sensor_msg(const odo_can_frame_t *f)
+{
+    if (f->flags != 0U) {
+        return ODO_CAN_MSG_UNKNOWN;
+    }
+    switch (f->id) {
+    case ODO_CAN_ID_WHEEL_COUNTS_A: return ODO_CAN_MSG_WHEEL_COUNTS_A;
+    case ODO_CAN_ID_WHEEL_COUNTS_B: return ODO_CAN_MSG_WHEEL_COUNTS_B;
+    case ODO_CAN_ID_LINK_ROTARY: return ODO_CAN_MSG_LINK_ROTARY;
+    case ODO_CAN_ID_LINK_LINEAR: return ODO_CAN_MSG_LINK_LINEAR;
+    default: return ODO_CAN_MSG_UNKNOWN;
+    }
+}
+
+/// Sequence number of a sensor frame of the right length: byte 6 of WHEEL_COUNTS, byte 4 of the
+/// linkage frames (can/odometry.dbc). False for anything else.
+static bool sensor_seq(const odo_can_frame_t *f, odo_can_msg_t m, uint8_t *seq)
+{
+    if (m == ODO_CAN_MSG_UNKNOWN || f->dlc != odo_can_expected_dlc(m)) {
+        return false;
+    }
+    *seq = f->data[(m == ODO_CAN_MSG_WHEEL_COUNTS_A || m == ODO_CAN_MSG_WHEEL_COUNTS_B) ? 6U : 4U];
     return true;
 }
 
@@ -66,18 +99,7 @@ static void take(replay_t *r, const odo_can_frame_t *f)
         r->stats.bus_off += (f->id & CAN_ERR_BUSOFF_CLASS) != 0U;
         return;
     }
-    /* The four consumed frames by identifier (what odo_can_classify would say, without its table
-     * walk: this runs for every frame of a replay). */
-    odo_can_msg_t m = ODO_CAN_MSG_UNKNOWN;
-    if (f->flags == 0U) {
-        switch (f->id) {
-        case ODO_CAN_ID_WHEEL_COUNTS_A: m = ODO_CAN_MSG_WHEEL_COUNTS_A; break;
-        case ODO_CAN_ID_WHEEL_COUNTS_B: m = ODO_CAN_MSG_WHEEL_COUNTS_B; break;
-        case ODO_CAN_ID_LINK_ROTARY: m = ODO_CAN_MSG_LINK_ROTARY; break;
-        case ODO_CAN_ID_LINK_LINEAR: m = ODO_CAN_MSG_LINK_LINEAR; break;
-        default: break;
-        }
-    }
+    const odo_can_msg_t m = sensor_msg(f);
     if (m == ODO_CAN_MSG_UNKNOWN) {
         r->stats.ignored++;
         return;
@@ -129,8 +151,47 @@ static void take(replay_t *r, const odo_can_frame_t *f)
         r->stats.dup_dropped++;
     } else {
         r->stats.sensor_frames++;
+        uint8_t seq = 0U;
+        (void)sensor_seq(f, m, &seq);
+        const unsigned i = (unsigned)m - (unsigned)ODO_CAN_MSG_WHEEL_COUNTS_A;
+        r->seq_known[i] = true;
+        r->seq_last[i] = seq;
+        r->seq_tick[i] = r->cur;
     }
 }
+
+/// Move the tick clock's anchor to (t_us, tick k >= cur). The open tick is closed first unless k
+/// is the open tick itself, and the empty ticks before k are stepped (at most 127).
+static void reanchor(replay_t *r, uint64_t t_us, uint64_t k)
+{
+    while (r->cur < k) {
+        step(r);
+    }
+    r->anchor_us = t_us;
+    r->anchor_tick = r->cur;
+    r->last_t_us = t_us;
+}
+
+/// The tick a frame opens after the clock stepped back: its sensor's previous sample's tick plus
+/// the sequence step (1..127) if that is not in the past; otherwise the tick after the open one.
+static uint64_t tick_by_seq(const replay_t *r, const odo_can_frame_t *f)
+{
+    const uint64_t next = r->pending ? r->cur + 1U : r->cur;
+    const odo_can_msg_t m = sensor_msg(f);
+    uint8_t seq = 0U;
+    if (!sensor_seq(f, m, &seq)) {
+        return next;
+    }
+    const unsigned i = (unsigned)m - (unsigned)ODO_CAN_MSG_WHEEL_COUNTS_A;
+    const uint8_t d = odo_can_seq_delta(r->seq_last[i], seq);
+    if (!r->seq_known[i] || d == 0U || d >= 128U) {
+        return next;
+    }
+    const uint64_t k = r->seq_tick[i] + d;
+    return k >= r->cur ? k : next;
+}
+
+static uint64_t sat_add(uint64_t a, uint64_t b) { return a > UINT64_MAX - b ? UINT64_MAX : a + b; }
 
 void replay_push(replay_t *r, const odo_can_frame_t *f, uint64_t t_us)
 {
@@ -138,32 +199,47 @@ void replay_push(replay_t *r, const odo_can_frame_t *f, uint64_t t_us)
     if (!r->have_origin) {
         r->have_origin = true;
         r->origin_us = t_us;
+        r->anchor_us = t_us;
+        r->anchor_tick = 0U;
         r->cur = 0U;
     }
-    uint64_t k = r->cur;
+    const uint64_t tick = r->tick_us;
+    const uint64_t half = tick / 2U;
     if (r->have_last && t_us < r->last_t_us) {
-        r->in.rx_faults |= ODO_FAULT_TIME_BACKWARDS;
         r->stats.time_backwards++;
-    } else {
-        /* k = round((t - t0) / tick). Most frames fall in the open tick: test its window first and
-         * divide only for a frame beyond it (a 64-bit division per frame is ~10 % of a replay). */
-        const uint64_t half = r->tick_us / 2U;
-        const uint64_t upper = r->origin_us + (r->cur + 1U) * (uint64_t)r->tick_us - half;
-        if (t_us < upper) {
-            const uint64_t lower = r->origin_us + r->cur * (uint64_t)r->tick_us; /* + half - half */
-            k = (r->cur > 0U && t_us + half < lower) ? 0U : r->cur; /* 0: any closed tick (late) */
-        } else {
-            k = (t_us - r->origin_us + half) / r->tick_us;
+        if (r->last_t_us - t_us > REPLAY_CLOCK_STEP_TICKS * tick) {
+            r->stats.clock_steps++;
+            /* the clock stepped back: new ticks, not folded into the open one */
+            reanchor(r, t_us, tick_by_seq(r, f));
         }
-        if (k < r->cur) {
-            r->stats.late++;
+        r->in.rx_faults |= ODO_FAULT_TIME_BACKWARDS; /* reordered frames join the open tick */
+    } else {
+        /* Tick of t relative to the anchor (t >= last frame >= anchor). Most frames fall in the
+         * open tick: test its window first and divide only for a frame beyond it (a 64-bit
+         * division per frame is ~10 % of a replay). Differences only: any t_us is safe. */
+        const uint64_t d = t_us - r->anchor_us;
+        const uint64_t open = r->cur - r->anchor_tick;
+        uint64_t k = r->cur;
+        if (d >= open * tick + (tick - half)) { /* beyond the open tick's window */
+            const uint64_t q = d / tick;
+            k = r->anchor_tick + q + ((d - q * tick) >= tick - half ? 1U : 0U);
+        } else if (open > 0U && d + half < open * tick) {
+            r->stats.late++; /* a tick already closed (live): joins the open one */
+        }
+        if (k - r->cur > REPLAY_MAX_GAP_TICKS) {
+            const uint64_t gap = t_us - (r->have_last ? r->last_t_us : t_us);
+            r->stats.gaps++;
+            r->stats.gap_us = sat_add(r->stats.gap_us, gap);
+            r->stats.longest_gap_us = gap > r->stats.longest_gap_us ? gap : r->stats.longest_gap_us;
+            r->stats.last_gap_us = gap;
+            reanchor(r, t_us, r->pending ? r->cur + 1U : r->cur); /* skipped, never ground through */
             k = r->cur;
         }
         r->last_t_us = t_us;
         r->have_last = true;
-    }
-    while (r->cur < k) {
-        step(r); /* ticks without frames step too: the firmware flags what is missing */
+        while (r->cur < k) {
+            step(r); /* ticks without frames step too: the firmware flags what is missing */
+        }
     }
     take(r, f);
     r->pending = true;

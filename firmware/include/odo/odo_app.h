@@ -30,10 +30,13 @@ extern "C" {
 #define ODO_APP_MAX_FRAMES 6U
 
 /// Flags byte of the POSE_THETA frames: what happened to that truck's pose this tick.
-#define ODO_POSE_FLAG_MISSING 0x01U ///< no wheel sample: pose held
-#define ODO_POSE_FLAG_JUMP    0x02U ///< implausible counter jump: pose held, baseline re-taken
-#define ODO_POSE_FLAG_IPEC    0x04U ///< an IPEC heading correction was applied
+#define ODO_POSE_FLAG_MISSING    0x01U ///< no wheel sample: pose held
+#define ODO_POSE_FLAG_JUMP       0x02U ///< implausible or ambiguous counter reading: pose held,
+                                       ///< baseline re-taken
+#define ODO_POSE_FLAG_IPEC       0x04U ///< an IPEC heading correction was applied
 #define ODO_POSE_FLAG_IPEC_GATED 0x08U ///< IPEC is on but was skipped this tick (see faults)
+#define ODO_POSE_FLAG_RANGE      0x10U ///< position beyond ODO_POSE_LIMIT_MM_Q32: pose held
+#define ODO_POSE_FLAG_XY_SATURATED 0x20U ///< POSE_XY carries a saturated x or y (beyond 21.47 km)
 
 /// Application state. Plain data, caller-allocated (static on the target); no pointers inside,
 /// so it can be copied to checkpoint a run.
@@ -47,9 +50,10 @@ typedef struct {
     uint8_t              out_seq;        ///< sequence number of the output frames
     bool                 seen_seq[ODO_TRUCKS];
     uint8_t              last_seq[ODO_TRUCKS];
+    uint64_t             last_wheel_t_us[ODO_TRUCKS]; ///< t_us of the truck's last wheel sample
     bool                 have_time;
     uint64_t             last_t_us;
-    uint32_t             ticks;          ///< steps run since init
+    uint32_t             ticks;          ///< steps run since init (wraps after 2^32)
     uint32_t             tx_dropped;     ///< output frames the HAL could not queue (odo_loop)
     odo_fault_counters_t faults;         ///< occurrences per fault bit, saturating
 } odo_app_t;
@@ -78,7 +82,20 @@ odo_params_status_t odo_app_init(odo_app_t *app, const uint8_t *block, size_t le
 /// and boots on defaults if they fail validation or the model precomputation.
 odo_params_status_t odo_app_init_params(odo_app_t *app, const odo_params_t *p);
 
-/// One application step. Pure: reads *in and *app, writes *app and *out. Constant time.
+/// One application step. Pure: reads *in and *app, writes *app and *out. Constant time. Every
+/// input is valid; what is wrong with it is reported in out->faults (ODO_FAULT_*), never asserted.
+///
+/// Lost samples lose no distance: a truck's wheel sample is integrated over the ticks elapsed
+/// since its previous one (odo_truck_step's `ticks`), counted by the sample's sequence number
+/// (8 bits) or, once in->t_us says 128 ticks or more have passed (the sequence number wraps at
+/// 256), by in->t_us (one 32-bit division, only then). A repeated sequence number counts as one
+/// tick, an older one (out of order) as its distance back. Time going backwards raises
+/// ODO_FAULT_TIME_BACKWARDS and the sequence number alone decides.
+///
+/// Range: a truck whose position is beyond ODO_POSE_LIMIT_MM_Q32 is held and flagged
+/// (ODO_FAULT_POSE_RANGE, ODO_POSE_FLAG_RANGE) and IPEC is gated; a position beyond POSE_XY's
+/// +-21.47 km is published saturated and flagged (ODO_FAULT_POSE_XY_SATURATED,
+/// ODO_POSE_FLAG_XY_SATURATED) while the pose itself goes on.
 void odo_app_step(odo_app_t *app, const odo_tick_input_t *in, odo_tick_output_t *out);
 
 #ifdef __cplusplus

@@ -44,12 +44,14 @@ bool odo_div_u128(odo_u128_t n, uint64_t d, uint64_t *q);
 /// 64 bits. Same cost as odo_div_u128.
 bool odo_muldiv_u64(uint64_t a, uint64_t b, uint64_t d, uint64_t *out);
 
-/// round(a * b / 2^shift) for shift in [1, 62], computed exactly through a 96-bit product so it
-/// cannot overflow as long as the true result fits in int64. Three 32x32 multiplies.
+/// round(a * b / 2^shift), ties away from zero, computed exactly through a 96-bit product. Every
+/// input is valid: any shift (0 is the plain product; 96 and above give 0, since |a * b| <= 2^94),
+/// and a result beyond int64 saturates to INT64_MIN / INT64_MAX. Three 32x32 multiplies.
 int64_t odo_mul_s64_s32_shr(int64_t a, int32_t b, unsigned shift);
 
-/// round(a * b / 2^shift) for an unsigned 32-bit b, shift in [1, 62]; exact through a 96-bit
-/// product as odo_mul_s64_s32_shr, rounding half away from zero. Three 32x32 multiplies.
+/// round(a * b / 2^shift) for an unsigned 32-bit b, as odo_mul_s64_s32_shr: exact through a
+/// 96-bit product, ties away from zero, every shift valid (96 and above give 0), saturating
+/// beyond int64. Three 32x32 multiplies.
 int64_t odo_mul_s64_u32_shr(int64_t a, uint32_t b, unsigned shift);
 
 /// The fraction n / d in Q32: round(n * 2^32 / d) for n < d, which is at most 2^32 - 1, so it
@@ -59,7 +61,9 @@ int64_t odo_mul_s64_u32_shr(int64_t a, uint32_t b, unsigned shift);
 /// 64-bit division: constant time apart from at most two corrections per digit.
 uint32_t odo_frac_q32(uint32_t n, uint32_t d);
 
-/// Arithmetic right shift of a signed value with rounding to nearest (shift in [1, 62]).
+/// round(v / 2^shift), ties away from zero (an arithmetic right shift with rounding to nearest).
+/// Every input is valid: shift 0 returns v; shift 64 and above return 0, except -1 for INT64_MIN
+/// at exactly 64 (|v| / 2^64 = 1/2). Never overflows.
 int64_t odo_shr_round_s64(int64_t v, unsigned shift);
 
 /// sin and cos of a binary angle, Q30. Constant time (octant fold + short polynomial).

@@ -53,7 +53,7 @@
 extern "C" {
 #endif
 
-/// ESTIMATOR: per-tick gain of the pull toward the code centre, as a right shift (1/16).
+/// ESTIMATOR: per-tick gain of the pull toward the code centre, as a right shift (6: 1/64).
 #ifndef ODO_IPEC_EST_PULL_SHIFT
 #define ODO_IPEC_EST_PULL_SHIFT 6U
 #endif
@@ -134,7 +134,7 @@ int32_t odo_ipec_gain(uint8_t ipec_mode, int32_t innov_bam, uint8_t rotary_bits)
 void odo_ipec_step(const odo_params_t *p, const odo_ipec_reading_t *rd, odo_pose_t pose[2],
                    int64_t dist_mm_q40, odo_ipec_result_t *out);
 
-/// nm -> mm Q32 (exact to 2e-10 relative; any int64 nm up to +-2^44).
+/// nm -> mm Q32 (exact to 2e-10 relative; saturates beyond +-2.1e15 nm, where mm Q32 leaves int64).
 int64_t odo_ipec_nm_to_mm_q32(int64_t nm);
 
 #ifdef __cplusplus

@@ -4,7 +4,8 @@
 ///
 /// Representations: position in mm Q32 (int64), heading in turns Q64 (uint64, wraps), per-wheel
 /// distance per count in mm Q40, per-wheel heading per count in turns Q64. One tick costs two
-/// 64x64 multiplies for the heading, two for distance and two 64x32 for position; no loops.
+/// 64x64 multiplies for the heading, two for distance and two 64x32 for position; no loops and no
+/// division (a step over a gap adds a few multiplies for the chord).
 ///
 /// Tyre scrub (effect `scrub` of the effects catalog; parameter scrub_q30 per truck): real robots
 /// show a larger effective wheelbase on arcs than on spot turns (the OptiOdom runs: Eb ~1.0065
@@ -48,6 +49,8 @@ typedef struct {
     uint64_t scrub_turn_q64[2]; ///< k * turn_q64[w], two's complement (the scrub term's k dtheta)
     int32_t  scrub_q30;       ///< k of the scrub term (odo_truck_params_t); 0: term skipped
     uint32_t max_counts;      ///< largest believable |delta| per tick (from max_wheel_speed_mm_s)
+    uint32_t max_delta_counts;///< largest |delta| one step can integrate (k |delta| < 2^61 mm Q40
+                              ///< on both wheels; >= max_counts), for steps over a gap
     uint8_t  counter_bits;    ///< decoder counter width, ODO_COUNTER_BITS_MIN..ODO_COUNTER_BITS_MAX
     uint8_t  invert;          ///< ODO_TRUCK_INVERT_* flags
     uint8_t  heading_form;    ///< odo_heading_form_t
@@ -65,7 +68,10 @@ typedef struct {
     int64_t  dist_mm_q40;  ///< centre-point displacement U_i (000 Eq. 2.3), mm Q40
     int64_t  dturn_q64;    ///< heading change dtheta_i (000 Eq. 2.4), signed turns Q64
     int32_t  delta[2];     ///< accepted count deltas, forward positive
-    bool     jump;         ///< a delta exceeded max_counts: nothing integrated, baseline re-taken
+    bool     jump;         ///< implausible or ambiguous reading (see odo_truck_step): nothing
+                           ///< integrated, baseline re-taken
+    bool     range;        ///< the pose is beyond ODO_POSE_LIMIT_MM_Q32 (odo_pose_in_range false);
+                           ///< if it already was, nothing was integrated (pose held)
 } odo_step_t;
 
 typedef enum {
@@ -92,22 +98,49 @@ odo_model_status_t odo_model_init(odo_model_t *m, const odo_truck_params_t *tp, 
                                   uint8_t heading_form, uint32_t tick_us,
                                   uint32_t max_wheel_speed_mm_s);
 
-/// Signed difference cur - prev of two raw counter readings modulo 2^bits (bits in [1, 32]),
-/// interpreted in [-2^(bits-1), 2^(bits-1)). Handles every wrap of any counter width.
+/// Signed difference cur - prev of two raw counter readings modulo 2^bits, interpreted in
+/// [-2^(bits-1), 2^(bits-1)). Handles every wrap of any counter width. bits above 32 count as
+/// 32; bits 0 returns 0 (no information). Constant time.
 int32_t odo_count_delta(uint32_t prev, uint32_t cur, uint8_t bits);
+
+/// The odometry integrates from x and y in [-L, L), L = 2^61 mm Q32 = 2^29 mm (536.87 km). One
+/// step moves a pose by less than 2^54 mm Q32, so positions stay below 2^62 in magnitude and every
+/// difference of two positions (IPEC's link vector) fits int64. Beyond, odo_truck_step holds it.
+#define ODO_POSE_LIMIT_MM_Q32 ((int64_t)1 << 61)
+
+/// True iff x and y are both in [-ODO_POSE_LIMIT_MM_Q32, ODO_POSE_LIMIT_MM_Q32). Constant time.
+bool odo_pose_in_range(const odo_pose_t *p);
 
 /// Reset a truck to a pose; the next reading sets the counter baseline.
 void odo_truck_reset(odo_truck_t *t, const odo_pose_t *pose);
 
 /// One dead-reckoning step from raw counter readings (000 Eqs. 2.2-2.6, with the scrub term).
-/// `bits` is the width the readings carry (a CAN frame carries 24); the modulus used is
-/// 2^min(bits, model counter_bits). On a jump (|delta| > max_counts on either wheel) the pose is
-/// not changed, the baseline is re-taken, and out->jump is true. Never fails otherwise.
+///   bits   the width the readings carry (a CAN frame carries 24); deltas are taken modulo 2^w,
+///          w = min(bits, the model's counter_bits).
+///   ticks  ticks elapsed since the previous reading (1: consecutive samples; 0 counts as 1).
+///          Counters are cumulative, so a reading after lost samples carries their motion, and
+///          the plausibility limit is max_counts * ticks.
+/// The first reading after odo_truck_reset only sets the baseline. out->jump is set, the pose is
+/// not changed and the baseline is re-taken when
+///   - |delta| > max_counts * ticks on either wheel (faster than max_wheel_speed_mm_s), or
+///     |delta| > max_delta_counts (a step too large to integrate), or
+///   - max_counts * ticks >= 2^(w-1): the wheel could have moved half the counter's range since
+///     the previous reading, so the modular delta is ambiguous whatever it reads (a gap too long
+///     for the counter width, or a w too narrow for one tick at the speed limit), or w == 0.
+/// out->range is set when the pose is beyond ODO_POSE_LIMIT_MM_Q32 after the step; a pose that was
+/// beyond it already is held (not integrated, baseline re-taken). A jump leaves out->range false.
+/// Over several ticks (ticks > 1) with the midpoint heading form, the position moves by the chord
+/// of the constant-curvature arc, U sin(dtheta/2) / (dtheta/2), along the midpoint heading: the
+/// arc's end, where U alone would overshoot by a part growing with the cube of the gap. Per tick
+/// it moves by U, as 000 Eq. 2.5 and the double reference have it. A heading change above half a
+/// turn in one step (a spin at speed over a long gap) is kept exactly modulo a turn (the scrub
+/// term, from two turns on), but its midpoint direction is then taken the short way round.
+/// Never fails otherwise. Constant time: no loop over the gap.
 void odo_truck_step(odo_truck_t *t, const odo_model_t *m, uint32_t left_raw, uint32_t right_raw,
-                    uint8_t bits, odo_step_t *out);
+                    uint8_t bits, uint32_t ticks, odo_step_t *out);
 
 /// The tyre-scrub part of one tick's heading change, k dtheta m / v in signed turns Q64 (the term
-/// above; odo_truck_step subtracts it when k != 0), for accepted deltas (|d| <= max_counts).
+/// above; odo_truck_step subtracts it when k != 0), for accepted deltas (|d| <= max_delta_counts).
 /// 0 unless both wheels moved the same strict way. Constant time: two 32-bit divisions at most.
 /// A function of its own so the k == 0 path of odo_truck_step carries none of its code.
 int64_t odo_scrub_dturn(const odo_model_t *m, int32_t d_left, int32_t d_right);
@@ -117,9 +150,10 @@ int64_t odo_scrub_dturn(const odo_model_t *m, int32_t d_left, int32_t d_right);
 void odo_pose_advance(odo_pose_t *p, int64_t dist_mm_q40, int64_t dturn_q64, uint8_t heading_form);
 
 /// Conversions for output: heading as BAM (rounded), position in units of 10 um (rounded,
-/// saturating to int32).
+/// saturating to int32: +-21.47 km, the POSE_XY frame's range; *saturated, if not NULL, is set
+/// true when it saturated and left alone otherwise).
 uint32_t odo_heading_bam(const odo_pose_t *p);
-int32_t  odo_mm_q32_to_10um(int64_t v_mm_q32);
+int32_t  odo_mm_q32_to_10um(int64_t v_mm_q32, bool *saturated);
 
 #ifdef __cplusplus
 }

@@ -10,7 +10,9 @@ extern "C" {
 #endif
 
 #define ODO_FAULT_PARAMS_DEFAULTED  (1UL << 0)  ///< parameter block rejected at boot; defaults in use
-#define ODO_FAULT_COUNTER_JUMP_A    (1UL << 1)  ///< a wheel count delta above the physical limit (truck A)
+#define ODO_FAULT_COUNTER_JUMP_A    (1UL << 1)  ///< a wheel count delta above the physical limit for
+                                                ///< the ticks elapsed, or a gap too long for the
+                                                ///< counter width to tell (truck A): not integrated
 #define ODO_FAULT_COUNTER_JUMP_B    (1UL << 2)
 #define ODO_FAULT_WHEEL_MISSING_A   (1UL << 3)  ///< no wheel-counter sample this tick (truck A)
 #define ODO_FAULT_WHEEL_MISSING_B   (1UL << 4)
@@ -27,8 +29,12 @@ extern "C" {
 #define ODO_FAULT_CAN_UNKNOWN_ID    (1UL << 15) ///< a frame with an identifier we do not consume
 #define ODO_FAULT_BUS_ERROR         (1UL << 16) ///< error frame / bus-off reported by the HAL
 #define ODO_FAULT_TIME_BACKWARDS    (1UL << 17) ///< an input timestamp older than the previous one
+#define ODO_FAULT_POSE_RANGE        (1UL << 18) ///< a truck's x or y beyond +-2^29 mm (536.87 km,
+                                                ///< ODO_POSE_LIMIT_MM_Q32): its pose is held
+#define ODO_FAULT_POSE_XY_SATURATED (1UL << 19) ///< a truck's x or y beyond POSE_XY's +-21.47 km:
+                                                ///< the frame carries the saturated value
 
-#define ODO_FAULT_COUNT 18U
+#define ODO_FAULT_COUNT 20U
 
 /// Occurrence counters, one per fault bit, saturating at UINT32_MAX.
 typedef struct {

@@ -38,8 +38,10 @@ typedef struct {
 /// One sample of a truck's two wheel-encoder counters, as the decoder (or the sensor frame) gives it.
 typedef struct {
     bool     present;      ///< a sample for this tick arrived; false: nothing arrived
-    uint8_t  bits;         ///< valid low bits in left/right_raw: 16, 24 or 32
-    uint8_t  seq;          ///< sender's sample sequence number (wraps at 256)
+    uint8_t  bits;         ///< valid low bits in left/right_raw, 8 to 32 (a CAN frame: 24);
+                           ///< above 32 counts as 32, 0 makes the sample unusable (flagged)
+    uint8_t  seq;          ///< sender's sample sequence number, +1 per tick (wraps at 256): a skip
+                           ///< says how many ticks the counters moved over
     uint8_t  status;       ///< sender's status bits, ODO_WHEEL_STATUS_*
     uint32_t left_raw;     ///< raw counter value, only the low `bits` bits are meaningful
     uint32_t right_raw;
@@ -79,7 +81,8 @@ typedef struct {
 
 /// A pose in the odometry frame: start at the origin heading +x; ccw positive.
 typedef struct {
-    int64_t  x_mm_q32;    ///< mm, 32 fraction bits (range +-2147 km, resolution 2.3e-10 mm)
+    int64_t  x_mm_q32;    ///< mm, 32 fraction bits (resolution 2.3e-10 mm); the odometry integrates
+                          ///< within +-536.87 km (ODO_POSE_LIMIT_MM_Q32, odo_odometry.h)
     int64_t  y_mm_q32;
     uint64_t heading_q64; ///< turns as a fraction of 2^64; the top 32 bits are the BAM heading
 } odo_pose_t;
