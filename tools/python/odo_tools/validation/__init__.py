@@ -1,1 +1,1 @@
-"""Validation of the gap diagnosis on worlds it did not generate (the blind check)."""
+"""Checks of the project's tools against worlds and data they did not generate (the blind check)."""
