@@ -132,6 +132,8 @@ def load(
         if mode == "truth":
             ds.instrument, ds.notes = instrument.estimate(prs, robot.n_trucks)
             ds.items = [TruthMode(pr, robot, ds.instrument) for pr in prs]
+            if ds.notes:
+                _lever_on_arcs(ds)
         elif mode == "returns":
             acc = None
             if return_accuracy is not None:
@@ -143,6 +145,35 @@ def load(
     except ValueError as e:
         raise GapInputError(folders[0], f"mode {mode}: {e}") from None
     return ds
+
+
+def _lever_on_arcs(ds: Dataset) -> None:
+    """Trucks whose lever arm the spot turns could not give: estimated on arcs, alternating with
+    a preliminary fit of the robot's geometry (the lever arm moves increments sideways, the
+    geometry turns the heading: two rounds settle them)."""
+    keys = [k for k in PRELIM if k.split(".")[0] in catalog.hypotheses("truth", ds.robot.vehicle)]
+    for _ in range(2):
+        prob = Problem("truth", ds.items)
+        P, _ = fit_params(prob, keys)
+        notes = []
+        for t in range(ds.robot.n_trucks):
+            if not any(n.startswith(f"truck {'AB'[t]}:") for n in ds.notes):
+                continue
+            o, se, n = instrument.on_arcs(ds.instrument, ds.prs, t, P)
+            if o is None:
+                notes.append(
+                    f"truck {'AB'[t]}: lever arm of the tracked point not estimated (no turns on "
+                    "the spot, too few arcs): taken as zero"
+                )
+                continue
+            ds.instrument.lever_se_mm[t] = se
+            ds.instrument.lever_mm[t] = o if instrument.significant(o, se) else (0.0, 0.0)
+            notes.append(
+                f"truck {'AB'[t]}: no turns on the spot: lever arm from {n} windows on arcs, "
+                "under a preliminary fit of Ed, Eb, Es and scrub"
+            )
+        ds.items = [TruthMode(pr, ds.robot, ds.instrument) for pr in ds.prs]
+    ds.notes = notes
 
 
 def recorded_accuracy(folders: list[Path]) -> tuple[float, float] | None:

@@ -95,6 +95,27 @@ class Problem:
         """(rows, channels) sigma^2 plus the walk's window variance (the diagonal)."""
         return np.vstack(self._var_parts({}))
 
+    def rough_cap(self) -> float:
+        """The largest roughness height the data allow: grains whose walk (catalog law, truck A's
+        wheels) is four times the walk measured on the fitting runs, driving or on the spot.
+        Roughness's variance grows with each window's travel, so uncapped it absorbed any
+        misfit that grows with speed (counts lost on a sprint, a lever arm on fast arcs) at its
+        10 mm bound, a scale error cancelling its mean; a floor that rough would walk far more
+        than the data do."""
+        from .model import rough_moments
+
+        if self.walk is None or not self.walk.q_wheel:
+            return float("inf")
+        qs = [*self.walk.q_wheel, *self.walk.q_turn]
+        qs += [hi for _, hi in (*self.walk.q_wheel_ci, *self.walk.q_turn_ci)]
+        q_max = 4.0 * max(qs)
+        R = self.items[0].pr.R[0]
+        for h in np.linspace(0.05, 10.0, 200):
+            m1, m2 = rough_moments(R, h)
+            if (m2 - m1 * m1 + m1 * m1 * 0.25 / 3.0) / 20.0 > q_max:
+                return float(max(h, 0.05))
+        return float("inf")
+
     def walk_k(self, P: dict) -> int:
         """Parameters the measured walk costs a hypothesis (none for roughness, which brings its
         own variance)."""
@@ -230,6 +251,11 @@ def fit_params(
         return base, {}
     lo, hi, x0 = zip(*(bounds(k) for k in keys), strict=False)
     x0 = list(x0)
+    if "roughness.max_height_mm" in keys:
+        r = keys.index("roughness.max_height_mm")
+        hi = list(hi)
+        hi[r] = min(hi[r], prob.rough_cap())
+        x0[r] = min(x0[r], 0.5 * hi[r])
     if warm:
         x0 = [warm.get(k, v) for k, v in zip(keys, x0, strict=False)]
 

@@ -34,6 +34,7 @@ LEVER_MIN_WINDOWS = 10
 LEVER_SIGNIFICANT = 3.0  # |o| in standard errors below which the lever arm is left at zero
 SPOT_TURN_RAD = 0.05  # a window turning at least this much ...
 SPOT_TRAVEL = 0.1  # ... while its centre moves less than this x (b/2) x |dtheta|
+TURN_RAD = 0.02  # without spot turns: every window that turns this much (arcs of both ways)
 
 
 def estimate(prs: list[Prepared], trucks: int) -> tuple[Instrument, list[str]]:
@@ -52,8 +53,7 @@ def estimate(prs: list[Prepared], trucks: int) -> tuple[Instrument, list[str]]:
             )
             continue
         inst.lever_se_mm[t] = se
-        z = math.hypot(o[0] / max(se[0], 1e-9), o[1] / max(se[1], 1e-9))
-        if z >= LEVER_SIGNIFICANT and math.hypot(*o) >= 1.0:
+        if significant(o, se):
             inst.lever_mm[t] = o
     return inst, notes
 
@@ -68,6 +68,23 @@ def under(inst: Instrument, prs: list[Prepared], P: dict) -> Instrument:
         if pr.run.truth is not None:
             out.latency_s[pr.run.name] = latency(pr, 0, P, min_tick=0.0)
     return out
+
+
+def on_arcs(
+    inst: Instrument, prs: list[Prepared], truck: int, P: dict
+) -> tuple[tuple[float, float] | None, tuple[float, float], int]:
+    """The lever arm where the robot never turns on the spot: on arcs of both directions, under a
+    candidate P for the robot's geometry (the caller's preliminary kinematic fit). On an arc the
+    marker's increments differ from the centre's by (R(dtheta) - I) o: a forward offset moves
+    them sideways, a sideways one along - with arcs of both directions neither is a scale error
+    or a skid. Without it the independent world's 30 mm markers read as roughness at its bound."""
+    with_truth = [pr for pr in prs if pr.run.truth is not None]
+    return lever_arm(with_truth, truck, inst, P, arcs=True)
+
+
+def significant(o, se) -> bool:
+    z = math.hypot(o[0] / max(se[0], 1e-9), o[1] / max(se[1], 1e-9))
+    return z >= LEVER_SIGNIFICANT and math.hypot(*o) >= 1.0
 
 
 def _windows(tt: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -128,9 +145,10 @@ def latency(pr: Prepared, truck: int = 0, P: dict | None = None, min_tick: float
 
 
 def lever_arm(
-    prs: list[Prepared], truck: int, inst: Instrument
+    prs: list[Prepared], truck: int, inst: Instrument, P: dict | None = None, arcs: bool = False
 ) -> tuple[tuple[float, float] | None, tuple[float, float], int]:
-    """Least squares of the marker's increments on spot turns: ((ox, oy), (se_x, se_y), windows)."""
+    """Least squares of the marker's increments on spot turns (or, with `arcs`, on every window
+    that turns at least TURN_RAD, the model under P): ((ox, oy), (se_x, se_y), windows)."""
     A_rows, r_rows = [], []
     for pr in prs:
         tr = pr.run.truth
@@ -142,15 +160,18 @@ def lever_arm(
         i, j = i[ok], j[ok]
         if i.size == 0:
             continue
-        p = dead_reckon(pr, {}, truck)
+        p = dead_reckon(pr, P or {}, truck)
         m = np.column_stack([np.interp(tt, pr.t, p[:, k]) for k in range(3)])
         inc_t = _body_inc(tr.pose[:, truck], i, j)
         inc_m = _body_inc(m, i, j)
         dth = inc_t[:, 2]
         travel = np.hypot(inc_m[:, 0], inc_m[:, 1])
-        spot = (np.abs(dth) >= SPOT_TURN_RAD) & (
-            travel < SPOT_TRAVEL * 0.5 * pr.b[truck] * np.abs(dth)
-        )
+        if arcs:
+            spot = np.abs(dth) >= TURN_RAD
+        else:
+            spot = (np.abs(dth) >= SPOT_TURN_RAD) & (
+                travel < SPOT_TRAVEL * 0.5 * pr.b[truck] * np.abs(dth)
+            )
         if not spot.any():
             continue
         c, s_ = np.cos(dth[spot]), np.sin(dth[spot])

@@ -294,13 +294,23 @@ def read_log(path: str | Path, robot: Robot) -> SensorLog:
 
 
 def _align(path: Path, t_frames: np.ndarray, t_ticks: np.ndarray, lines: np.ndarray) -> np.ndarray:
-    idx = np.searchsorted(t_ticks, t_frames - 1e-7)
-    idx = np.clip(idx, 0, t_ticks.size - 1)
-    off = np.abs(t_ticks[idx] - t_frames) > 1e-5
+    """The tick each frame belongs to: the nearest WHEEL_COUNTS_A frame, within half a tick.
+
+    A robot's controllers put one tick's frames on the bus a little apart (the independent
+    world stamps them a few hundred microseconds after each other, as a real bus does); only a
+    frame half a tick or more from every WHEEL_COUNTS_A frame belongs to no tick."""
+    n = t_ticks.size
+    half = 0.5 * float(np.median(np.diff(t_ticks))) if n > 1 else 0.5
+    j = np.searchsorted(t_ticks, t_frames)
+    left, right = np.clip(j - 1, 0, n - 1), np.clip(j, 0, n - 1)
+    closer_left = np.abs(t_frames - t_ticks[left]) <= np.abs(t_ticks[right] - t_frames)
+    idx = np.where(closer_left, left, right)
+    off = np.abs(t_ticks[idx] - t_frames) >= half
     if off.any():
         raise GapInputError(
             path,
-            "frame without a WHEEL_COUNTS_A frame of the same tick",
+            "frame without a WHEEL_COUNTS_A frame of the same tick (half a tick or more from "
+            "every one)",
             int(lines[np.argmax(off)]) + 1,
         )
     return idx

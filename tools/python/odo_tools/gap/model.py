@@ -44,7 +44,9 @@ def prepare(run: RunData, robot: Robot) -> Prepared:
     n, T = c.shape[0], c.shape[1]
     ds = np.zeros((n - 1, T, 2))
     for t in range(T):
-        bits = robot.trucks[t]["counter_bits"]
+        # the frame carries the counter's low bits (can/odometry.dbc: 24): a 32-bit decoder
+        # wraps on the bus at 2^24, a 16-bit one at 2^16
+        bits = min(robot.trucks[t]["counter_bits"], _count_bits(t))
         mod, half = 1 << bits, 1 << (bits - 1)
         d = (np.diff(c[:, t, :], axis=0) + half) % mod - half  # counter wraparound
         if robot.trucks[t]["invert_left"]:
@@ -64,6 +66,14 @@ def prepare(run: RunData, robot: Robot) -> Prepared:
         driven=[t == 0 or robot.vehicle == "clapper" for t in range(T)],
         link=_link_start(run, robot),
     )
+
+
+def _count_bits(truck: int) -> int:
+    """Width of a wheel counter in the WHEEL_COUNTS frames (can/odometry.dbc)."""
+    from .io import ID_WHEEL, dbc_layouts
+
+    fid = next(f for f, t in ID_WHEEL.items() if t == truck)
+    return int(dbc_layouts()[fid]["LeftCount"].length)
 
 
 def _link_start(run: RunData, robot: Robot) -> tuple | None:
