@@ -46,6 +46,9 @@ class Background:
     # truth, per truck: the longitudinal channel's own walk, mm^2 per mm of both wheels' travel
     # (travel a floor takes or gives beyond what turns the heading)
     q_long: list[float] = field(default_factory=list)
+    # truth, per truck: the walk of the whole residual under the candidate, repeatable part and
+    # all (driving, on the spot): what the remainder looks like, beside what is background
+    q_all: list[tuple[float, float]] = field(default_factory=list)
     # truth: each truck channel's noise per window at the window scale (sqrt(intercept / 3) of
     # the multi-scale fit: 3 window variances for white sample noise), which also holds noise
     # correlated over a window that the samples' second differences miss
@@ -266,6 +269,11 @@ def measure(
             bg.q_turn_ci.append(
                 (float(np.percentile(bm[:, 1], 16)), float(np.percentile(bm[:, 1], 84)))
             )
+            whole = [
+                (r[:, 3 * t + 2], E)
+                for r, (_, E) in zip(res, unrepeated_expo(items, t), strict=False)
+            ]
+            bg.q_all.append(walk_by_phase(whole, b))
             per_long = unrepeated(items, [r[:, 3 * t] for r in res], t)
             bg.q_long.append(_multiscale([(d, E.sum(axis=1)) for d, E in per_long])[1])
     elif mode == "returns":
@@ -314,6 +322,14 @@ def spot_turn_deg(q_turn: float, b_mm: float) -> float:
     """The walk on the spot in words: heading spread (deg) of one 90 deg turn on the spot (both
     wheels roll pi b / 4 each)."""
     return math.degrees(math.sqrt(max(q_turn, 0.0) * math.pi * b_mm / 2.0) / b_mm)
+
+
+def unrepeated_expo(items: list, t: int) -> list[tuple[None, np.ndarray]]:
+    """Per run: (None, (nwin, 2) travel driving and on the spot), as `unrepeated` gives it."""
+    return [
+        (None, np.column_stack([it.wtravel[t, 0] + it.wtravel[t, 1] - it.wturn[t], it.wturn[t]]))
+        for it in items
+    ]
 
 
 def heading_walk_deg_per_sqrt_m(q_wheel: float, b_mm: float) -> float:

@@ -24,6 +24,11 @@ DBIC_PAIR = 10.0  # a pair must beat the best single by this much (quasi-BIC)
 Z_GAP = 5.0  # nominal misfit above the noise-only chi^2, in its standard deviations: a gap
 
 
+def has_rough(P: dict) -> bool:
+    """A roughness on any truck (its law brings its own variance)."""
+    return any(k.startswith("roughness.max_height_mm") and v > 0 for k, v in P.items())
+
+
 @dataclass
 class Problem:
     """The fitting runs of one mode: residual builders, noise, data count.
@@ -64,7 +69,7 @@ class Problem:
         over many windows by the whole run, and on the OptiOdom robot, whose motion-capture noise
         is correlated and whose truth carries slow offsets after each start, it fitted Ed 1.066
         (returns say 0.999): local increments are the robust choice for real truth."""
-        rough = P.get("roughness.max_height_mm", 0.0) > 0
+        rough = has_rough(P)
         cache = self.__dict__.setdefault("_vcache", {})
         if rough not in cache:
             parts = []
@@ -121,7 +126,7 @@ class Problem:
         own variance)."""
         if self.walk is None or not self.walk.active:
             return 0
-        return 0 if P.get("roughness.max_height_mm", 0.0) > 0 else 1
+        return 0 if has_rough(P) else 1
 
     def deviance(self, P: dict) -> tuple[float, float, int]:
         """(-2 ln L relative to sigma, chi^2 of the whitened residuals, n scalars)."""
@@ -179,10 +184,11 @@ def estimate_sigma(items: list, mode: str) -> np.ndarray:
         return np.maximum(s, np.array([0.5, 0.5, 1e-4]))
     if mode == "truth":
         for c, ch in enumerate(items[0].channels()):
-            if ch in ("alpha_rad", "beta_rad"):  # encoder quantisation (10 bit: 0.1 deg)
-                floor[c] = items[0].q_rad
-            elif ch == "l_mm":
-                floor[c] = items[0].q_l_mm
+            if ch in ("alpha_rad", "beta_rad", "l_mm"):
+                # encoder quantisation (10 bit: 0.1 deg; 0.1 mm), and the truth's own noise on
+                # the linkage where it is larger (TruthMode.link_sigma)
+                k = ("alpha_rad", "beta_rad", "l_mm").index(ch)
+                floor[c] = max(float(it.link_sigma()[k]) for it in items)
         # the truck channels: the truth's own sample noise (TruthMode.noise_diffs), measured on
         # every sample of every fitting run. A window's increment carries the noise of its two
         # end samples: sqrt(2) sigma per body axis and for the heading. (The spread of the few

@@ -46,11 +46,19 @@ class Law:
     name: str  # "catalog", "acceleration", "traction", "above a speed"
     params: tuple[str, ...]  # fitted keys
     doc: str
+    truck: str | None = None  # "A" or "B": on that truck only (model.truck_view)
 
     @property
     def key(self) -> str:
-        """How the hypothesis is named in rankings: 'slip', 'slip@traction'."""
-        return self.family if self.name == "catalog" else f"{self.family}@{self.name}"
+        """How the hypothesis is named in rankings: 'slip', 'slip@traction', 'ed[B]'."""
+        k = self.family if self.name == "catalog" else f"{self.family}@{self.name}"
+        return k if self.truck is None else f"{k}[{self.truck}]"
+
+    def on(self, truck: str) -> Law:
+        """The same law on one truck of a clapper or set."""
+        return Law(
+            self.family, self.name, tuple(f"{p}.{truck}" for p in self.params), self.doc, truck
+        )
 
 
 def catalog_law(effect: str, vehicle: str) -> Law:
@@ -146,8 +154,26 @@ def other_laws(family: str, mode: str, vehicle: str) -> list[Hypothesis]:
     return [Hypothesis((law,)) for law in OTHER_LAWS.get(family, ()) if law.name != skip]
 
 
+def on_truck(h: Hypothesis, truck: str) -> Hypothesis | None:
+    """A single hypothesis of a truck-scoped effect restricted to one truck (None otherwise)."""
+    if len(h.laws) != 1 or h.has_bumps:
+        return None
+    law = h.laws[0]
+    if law.truck is not None or catalog.effects()[law.family]["scope"] != "truck":
+        return None
+    if law.family == "roughness":  # one floor under both trucks
+        return None
+    return Hypothesis((law.on(truck),))
+
+
+TRUCK_SHARE = 0.75  # a truck holding this share of the excess misfit proposes its own variants
+
+
 def bounds(key: str) -> tuple[float, float, float]:
-    """(min, max, start) of a fitted parameter: the catalog's range, or EXTRA_BOUNDS."""
+    """(min, max, start) of a fitted parameter: the catalog's range, or EXTRA_BOUNDS (a truck's
+    own copy, 'ed.value.B', has the bounds of 'ed.value')."""
+    if key.endswith((".A", ".B")):
+        key = key[:-2]
     if key in EXTRA_BOUNDS:
         return EXTRA_BOUNDS[key]
     lo, hi, d = catalog.bounds(key)

@@ -25,7 +25,7 @@ import math
 import numpy as np
 
 from .model import Prepared, dead_reckon
-from .modes import WINDOW_S, Instrument, _body_inc
+from .modes import WINDOW_S, Instrument, _body_inc, to_centre
 
 LATENCY_MAX_S = 0.5
 LATENCY_STEP_S = 0.005
@@ -87,6 +87,12 @@ def significant(o, se) -> bool:
     return z >= LEVER_SIGNIFICANT and math.hypot(*o) >= 1.0
 
 
+def inst_lever(pr: Prepared, truck: int) -> tuple[float, float]:
+    """The lever arm known for this run's truck while its latency is estimated (none yet: the
+    lever arm needs the latency first; a lever arm moves travel increments only on turns)."""
+    return (0.0, 0.0)
+
+
 def _windows(tt: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     dt = float(np.median(np.diff(tt)))
     W = max(1, round(WINDOW_S / dt))
@@ -99,23 +105,30 @@ def _mad(x: np.ndarray) -> float:
 
 
 def latency(pr: Prepared, truck: int = 0, P: dict | None = None, min_tick: float = 0.5) -> float:
-    """The shift (s) that best lines the truth's heading increments up with the model's (P,
-    nominal by default), or 0 when no shift helps beyond chance or it is shorter than
-    `min_tick` count ticks."""
+    """The shift (s) that best lines the truth's heading and travel increments up with the
+    model's (P, nominal by default), or 0 when no shift helps beyond chance or it is shorter than
+    `min_tick` count ticks. Heading (times half the wheelbase) and travel both count: a run that
+    only drives straight (a sprint) shows its latency in its travel alone."""
     tr = pr.run.truth
-    th_m = dead_reckon(pr, P or {}, truck)[:, 2]
-    tt, th_t = tr.t_s, tr.pose[:, truck, 2]
+    p = dead_reckon(pr, P or {}, truck)
+    tt = tr.t_s
     i, j = _windows(tt)
     if i.size < 10:
         return 0.0
-    dth = th_t[j] - th_t[i]
+    tp = to_centre(tr.pose[:, truck : truck + 1], [inst_lever(pr, truck)])[:, 0]
+    half_b = 0.5 * pr.b[truck]
+    dth = tp[j, 2] - tp[i, 2]
+    c, s_ = np.cos(tp[i, 2]), np.sin(tp[i, 2])
+    dlong = c * (tp[j, 0] - tp[i, 0]) + s_ * (tp[j, 1] - tp[i, 1])
 
     def resid(L: float) -> np.ndarray:
         tm = tt - L
         ok = (tm[i] >= pr.t[0]) & (tm[j] <= pr.t[-1])
-        m = np.interp(tm, pr.t, th_m)
-        r = dth - (m[j] - m[i])
-        return np.where(ok, r, np.nan)
+        m = np.column_stack([np.interp(tm, pr.t, p[:, k]) for k in range(3)])
+        cm, sm = np.cos(m[i, 2]), np.sin(m[i, 2])
+        ml = cm * (m[j, 0] - m[i, 0]) + sm * (m[j, 1] - m[i, 1])
+        r = np.concatenate([(dth - (m[j, 2] - m[i, 2])) * half_b, dlong - ml])
+        return np.where(np.concatenate([ok, ok]), r, np.nan)
 
     grid = np.arange(-LATENCY_MAX_S, LATENCY_MAX_S + 1e-9, LATENCY_STEP_S)
     R = np.array([resid(L) for L in grid])

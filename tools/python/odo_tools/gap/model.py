@@ -163,11 +163,22 @@ def rough_window_var(R: float, hmax: float, L: np.ndarray, n: int = 32) -> tuple
     return (dd * dd * q).mean(axis=1), (dd * q).mean(axis=1), q.mean(axis=1)
 
 
+def truck_view(P: dict, truck: int) -> dict:
+    """The parameters that act on one truck: 'effect.param' acts on every truck, and
+    'effect.param.A' / '.B' on that truck only (a hypothesis scoped to one truck: the
+    independent world puts a truck-scoped effect on one truck of a clapper or set)."""
+    out = {k: v for k, v in P.items() if not k.endswith((".A", ".B"))}
+    suf = "." + "AB"[truck]
+    out.update({k[:-2]: v for k, v in P.items() if k.endswith(suf)})
+    return out
+
+
 def floor_travel(
     pr: Prepared, P: dict, truck: int
 ) -> tuple[np.ndarray, float, np.ndarray, np.ndarray | None]:
     """(n-1, 2) floor travel per tick, true wheelbase, (n-1,) lateral skid per tick (mm), (n-1,)
     factor on each tick's heading change (scrub; None when there is none)."""
+    P = truck_view(P, truck)
     ds = pr.ds[:, truck, :].copy()
     R, b = pr.R[truck], pr.b[truck]
     gl, gr = wheel_factors(P, R, b)

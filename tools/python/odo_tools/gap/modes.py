@@ -18,7 +18,15 @@ from typing import Protocol
 import numpy as np
 
 from .io import Robot
-from .model import Prepared, dead_reckon, link_bias, rough_moments, rough_window_var, wrap_rad
+from .model import (
+    Prepared,
+    dead_reckon,
+    link_bias,
+    rough_moments,
+    rough_window_var,
+    truck_view,
+    wrap_rad,
+)
 
 WINDOW_S = 0.4  # truth increments: window length
 HORIZON_S = 1.0  # linkage mode: prediction horizon
@@ -96,6 +104,43 @@ def spot_ticks(pr: Prepared) -> np.ndarray:
     return (pr.ds[:, :, 0] * pr.ds[:, :, 1]) < 0.0
 
 
+def link_from_poses(pose: np.ndarray, robot: Robot) -> np.ndarray:
+    """(n, 3) alpha, beta (rad), l (mm) of a clapper (theta_L from B to A, 002 Eqs. 10, 11 as
+    host_sim's world.c) or alpha and the bar length of a set (alpha = theta_A - theta_trailer),
+    from the trucks' poses (n, 2, 3)."""
+    a, b = pose[:, 0], pose[:, 1]
+    if robot.vehicle == "clapper":
+        thl = np.arctan2(a[:, 1] - b[:, 1], a[:, 0] - b[:, 0])
+        return np.column_stack(
+            [
+                wrap_rad(a[:, 2] - thl),
+                wrap_rad(b[:, 2] - thl),
+                np.hypot(a[:, 0] - b[:, 0], a[:, 1] - b[:, 1]),
+            ]
+        )
+    L = robot.trailer.get("trailer_length_mm", 0.0)
+    return np.column_stack(
+        [wrap_rad(a[:, 2] - b[:, 2]), np.zeros(a.shape[0]), np.full(a.shape[0], L)]
+    )
+
+
+def _sample_noise(t: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """Per column of x (n, k): white noise sigma of the samples, from second divided differences
+    (robust: a median)."""
+    h1, h2 = np.diff(t)[:-1], np.diff(t)[1:]
+    ok = (h1 > 0) & (h2 > 0)
+    if ok.sum() < 10:
+        return np.zeros(x.shape[1])
+    h1, h2 = h1[ok], h2[ok]
+    w0, w2 = 1.0 / h1, 1.0 / h2
+    w1 = w0 + w2
+    d = (w2[:, None] * x[2:][ok] - w1[:, None] * x[1:-1][ok] + w0[:, None] * x[:-2][ok]) * np.sqrt(
+        6.0 / (w0 * w0 + w1 * w1 + w2 * w2)
+    )[:, None]
+    med = np.median(d, axis=0)
+    return 1.4826 * np.median(np.abs(d - med), axis=0) / math.sqrt(6.0)
+
+
 def _grain_count_cv2(P: dict) -> float:
     """Squared coefficient of variation of the grain count: gaps spacing * (1 + jitter U(-1, 1))
     make a renewal count of variance n cv^2, cv^2 = jitter^2 / 3."""
@@ -131,7 +176,12 @@ class TruthMode:
             raise ValueError(f"{pr.run.name}: fewer than 10 truth samples overlap the log")
         self.tt = t_true[sel]
         self.tpose = to_centre(tr.pose[sel], inst.lever_mm)
-        self.tlink = tr.link[sel] if tr.link is not None else None
+        # the true linkage from the two trucks' (centre) poses, with the same lever arms and
+        # latency as the trucks: a linkage column the motion capture derived from its markers
+        # carries their lever arms as offsets a rotary or link-length bias would take up (the
+        # independent world's clapper); the simulator's exact columns agree with this to the
+        # truth's noise
+        self.tlink = link_from_poses(self.tpose, robot) if tr.link is not None else None
         dt = float(np.median(np.diff(self.tt)))
         W = max(1, round(WINDOW_S / dt))
         self.i = np.arange(0, self.tt.size - W, W)
@@ -160,6 +210,15 @@ class TruthMode:
                     lg.l_mm[k] if lg.l_mm is not None else np.zeros(k.size),
                 ]
             )
+            # the true linkage is measured too (by the motion capture, from two markers): where
+            # its own noise exceeds the encoder's cell the reading is compared with it as a
+            # Gaussian channel (cell centre, noise + quantisation), else interval-censored (the
+            # simulator's exact linkage). A 2.6 m link tracked at 0.5 mm per marker is ~0.7 mm
+            # of noise against a 0.02 mm linear encoder cell: censoring read that as a misfit
+            # 10^5 times the noise (the independent world's clapper).
+            self.link_noise = _sample_noise(self.tt, self.tlink)
+            steps = np.array([self.step_rad, self.step_rad, self.step_l_mm])
+            self.link_gauss = self.link_noise > steps / math.sqrt(12.0)
         # nominal travel in each window (roughness variance; stationary detection)
         S = pr.S
         self.wtravel = np.stack(
@@ -205,8 +264,16 @@ class TruthMode:
     def noise_weights(self) -> np.ndarray:
         """Expected z^2 per value of each channel under noise alone (fit.Problem.e0)."""
         w = np.ones(len(self.channels()))
-        w[3 * self.trucks :] = 0.0  # censored linkage readings: zero inside the cell
+        if self.has_link:  # censored linkage readings: zero inside the cell
+            n = len(self.channels()) - 3 * self.trucks
+            w[3 * self.trucks :] = self.link_gauss[:n].astype(float)
         return w
+
+    def link_sigma(self) -> np.ndarray:
+        """Per linkage channel: the truth's own noise plus the cell's quantisation where the
+        channel is Gaussian; the quantisation where it is censored."""
+        steps = np.array([self.step_rad, self.step_rad, self.step_l_mm]) / math.sqrt(12.0)
+        return np.where(self.link_gauss, np.hypot(self.link_noise, steps), steps)
 
     def residuals(self, P: dict) -> np.ndarray:
         cols = []
@@ -217,10 +284,18 @@ class TruthMode:
             tl = self.tlink[self.i]
             ba, bb, bl = link_bias(P, tl[:, 0], tl[:, 1])
             m = self.meas[self.i]
-            ra = _censored(tl[:, 0] + math.radians(ba), m[:, 0], self.step_rad, True)
+            g = self.link_gauss
+
+            def res(c: int, x: np.ndarray, step: float, angle: bool) -> np.ndarray:
+                if not g[c]:
+                    return _censored(x, m[:, c], step, angle)
+                d = m[:, c] + 0.5 * step - x  # the cell's centre against the measured truth
+                return wrap_rad(d) if angle else d
+
+            ra = res(0, tl[:, 0] + math.radians(ba), self.step_rad, True)
             if self.robot.vehicle == "clapper":
-                rb = _censored(tl[:, 1] + math.radians(bb), m[:, 1], self.step_rad, True)
-                rl = _censored(tl[:, 2] + bl, m[:, 2], self.step_l_mm, False)
+                rb = res(1, tl[:, 1] + math.radians(bb), self.step_rad, True)
+                rl = res(2, tl[:, 2] + bl, self.step_l_mm, False)
                 cols.append(np.column_stack([ra, rb, rl]))
             else:
                 cols.append(ra[:, None])
@@ -261,7 +336,7 @@ class TruthMode:
         return np.hstack(cols)
 
     def extra_var(self, P: dict) -> np.ndarray | None:
-        h = P.get("roughness.max_height_mm", 0.0)
+        h = max(truck_view(P, t).get("roughness.max_height_mm", 0.0) for t in range(self.trucks))
         if h <= 0:
             return None
         sp = P.get("roughness.spacing_mm", 20.0)
@@ -274,6 +349,9 @@ class TruthMode:
             # each wheel: grains cut by the window's ends count by their share only
             # (model.rough_window_var; without it the variance was ~20 % too high on 0.4 s
             # windows and pulled the height down, an es making up the mean)
+            h = truck_view(P, t).get("roughness.max_height_mm", 0.0)
+            if h <= 0:
+                continue
             m1, _ = rough_moments(self.pr.R[t], h)
             var = np.zeros(self.i.size)
             for w in (0, 1):

@@ -55,6 +55,8 @@ def words(label: str) -> str:
 
 
 def unit(key: str) -> str:
+    if key.endswith((".A", ".B")):
+        key = key[:-2]
     fam, p = key.split(".", 1)
     fam = fam.split("@")[0]
     try:
@@ -175,6 +177,7 @@ class Report:
             bgd["walk_q_turn_mm2_per_mm"] = bg.q_turn
             bgd["walk_q_turn_68ci"] = [list(x) for x in bg.q_turn_ci]
             bgd["walk_q_long_mm2_per_mm"] = bg.q_long
+            bgd["walk_q_with_repeatable_part"] = [list(x) for x in bg.q_all]
             bgd["heading_walk_deg_per_m"] = [
                 heading_walk_deg_per_sqrt_m(q, ds.prs[0].b[t]) for t, q in enumerate(bg.q_wheel)
             ]

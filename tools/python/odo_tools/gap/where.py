@@ -85,6 +85,21 @@ def phase_excess(items: list, P: dict, sigma: np.ndarray) -> dict[str, tuple[flo
     return {ph: (v[0] / tot, v[1] / n_all) for ph, v in acc.items()}
 
 
+def truck_excess(items: list, P: dict, sigma: np.ndarray) -> list[float]:
+    """Truth mode, two trucks: each truck's share of the excess misfit (z^2 - 1 summed over its
+    three channels and every window)."""
+    ex = np.zeros(getattr(items[0], "trucks", 1))
+    for it in items:
+        if not isinstance(it, TruthMode):
+            return []
+        r = it.residuals(P)
+        for t in range(it.trucks):
+            z = r[:, 3 * t : 3 * t + 3] / sigma[3 * t : 3 * t + 3]
+            ex[t] += float(np.maximum((z * z).sum(axis=1) - 3.0, 0.0).sum())
+    tot = ex.sum()
+    return (ex / tot).tolist() if tot > 0 else []
+
+
 def where_analysis(items: list, prs: list[Prepared], f: Fit | None, chans, sigma) -> list[dict]:
     out = []
     for it, pr in zip(items, prs, strict=False):
