@@ -168,6 +168,13 @@ def _lever_on_arcs(ds: Dataset) -> None:
                 continue
             ds.instrument.lever_se_mm[t] = se
             ds.instrument.lever_mm[t] = o if instrument.significant(o, se) else (0.0, 0.0)
+            if t == 0:  # the latency again, with this lever arm
+                wt = [pr for pr in ds.prs if pr.run.truth is not None]
+                found = {
+                    pr.run.name: instrument.latency(pr, lever=ds.instrument.lever_mm[0])
+                    for pr in wt
+                }
+                ds.instrument.latency_s.update(instrument.session_latencies(wt, found))
             notes.append(
                 f"truck {'AB'[t]}: no turns on the spot: lever arm from {n} windows on arcs, "
                 "under a preliminary fit of Ed, Eb, Es and scrub"
