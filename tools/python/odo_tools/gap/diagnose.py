@@ -298,7 +298,42 @@ def rank(ds: Dataset, sel: Selection, progress: Progress = None) -> Ranking:
         tri = next((f for f in third if f.bic < best.bic), None)
         if tri is not None and _more(best, tri, prob, ds, sel):
             best = tri
+    best = _floor_or_scale(best, prob, ds.robot.vehicle)
     return Ranking(prob, null, singles, cands, best, c_hat, gof, proposals, phases)
+
+
+FLOOR_RATIO = 2.0
+
+
+def _floor_or_scale(best: Fit, prob: Problem, vehicle: str) -> Fit:
+    """An Es that the floor's own walk accounts for is the floor. Roughness shortens every
+    wheel's travel on average (an Es) and walks it (the measured background); its law ties the
+    two. When the best candidate holds an Es whose shortening is within a factor FLOOR_RATIO of
+    what grains walking as much as the measured floor would give, and the walk is measured at
+    all, the effect is named roughness (same parameters: the Es is its mean). The roughness
+    hypothesis itself, its height set by the walk, loses such ties by a few tens of BIC where the
+    walk is estimated a little low."""
+    if best.hyp is None or "es" not in best.hyp.families or "roughness" in best.hyp.families:
+        return best
+    if prob.walk is None or not prob.walk.q_wheel_ci or prob.walk.q_wheel_ci[0][0] <= 0:
+        return best
+    from .model import rough_moments
+
+    h = prob.rough_from_walk()
+    if h <= 0:
+        return best
+    m1, _ = rough_moments(prob.items[0].pr.R[0], h)
+    predicted = m1 / 20.0  # catalog spacing
+    es = best.params.get("es.value", 1.0)
+    seen = 1.0 - 1.0 / es
+    if predicted <= 0 or not (1.0 / FLOOR_RATIO <= seen / predicted <= FLOOR_RATIO):
+        return best
+    rough = next(x for x in hypotheses.singles(prob.mode, vehicle) if x.name == "roughness")
+    laws = tuple(law for law in best.hyp.laws if law.family != "es") + rough.laws
+    return Fit(
+        best.name, best.params, best.stderr, best.dev, best.chi, best.n, best.k, best.bumps,
+        hypotheses.Hypothesis(laws),
+    )  # fmt: skip
 
 
 TRACK_GAIN = 1.5  # a further member must cut the fitting runs' track misfit by this factor ...
@@ -498,7 +533,40 @@ def _relatency(ds: Dataset, sel: Selection, rk: Ranking) -> bool:
     else:
         alt = evaluate(prob, "nominal", {}, {}, 0)
     n_lat = sum(1 for pr in fprs if abs(inst.latency_s.get(pr.run.name, 0.0)) > 0)
-    if alt.bic + n_lat * math.log(max(alt.n, 2)) >= best.bic:
+    if alt.bic + n_lat * math.log(max(alt.n, 2)) + DBIC_SIGNIFICANT >= best.bic:
+        return False
+    if not all(instrument.one_clock(ds.prs, inst.latency_s).values()):
+        return False
+    ds.instrument = inst
+    ds.items = items
+    return True
+
+
+def _slip_not_latency(ds: Dataset, sel: Selection, rk: Ranking) -> bool:
+    """The converse of `_relatency`: runs given a latency, and a best candidate without slip -
+    is the latency the robot's slip? The candidate plus catalog slip is fitted on the items
+    without latency; if that explains the fitting runs better (each latency one parameter),
+    the latencies go and the ranking runs again (True). The blind check's simulator has no
+    latency, but its slip on rect-7x4's faster starts read as 25 ms, and scrub took the rest."""
+    best = rk.best
+    if ds.mode != "truth" or ds.instrument is None or best.hyp is None:
+        return False
+    fprs = [ds.prs[i] for i in sel.fit]
+    lat = [pr for pr in fprs if abs(ds.instrument.latency_s.get(pr.run.name, 0.0)) > 0]
+    if not lat or "slip" in best.hyp.families:
+        return False
+    inst = Instrument(
+        list(ds.instrument.lever_mm), list(ds.instrument.lever_se_mm),
+        {k: 0.0 for k in ds.instrument.latency_s},
+    )  # fmt: skip
+    items = [TruthMode(pr, ds.robot, inst) for pr in ds.prs]
+    prob = Problem("truth", [items[i] for i in sel.fit], rk.prob.sigma)
+    prob.set_background(rk.prob.walk, rk.prob.sigma)
+    slip = next(h for h in hypotheses.singles("truth", ds.robot.vehicle) if h.name == "slip")
+    alt = fit_hypothesis(
+        best.hyp + slip, prob, fprs, _sig_head(prob, items[0].channels()), warm=best.model_params()
+    )
+    if alt.bic >= best.bic - len(lat) * math.log(max(best.n, 2)):
         return False
     ds.instrument = inst
     ds.items = items
@@ -522,9 +590,9 @@ def diagnose(
     ds = load(real, robot_path, mode, return_accuracy, groups)
     sel = select_runs(ds, holdout, seed, fit, judge_runs)
     rk = rank(ds, sel, progress)
-    if _relatency(ds, sel, rk):
+    if _relatency(ds, sel, rk) or _slip_not_latency(ds, sel, rk):
         if progress:
-            progress("latency moved under the best candidate: ranking again")
+            progress("latency and slip told apart: ranking again")
         rk = rank(ds, sel, progress)
     jd = judge(ds, sel, rk)
     fit_items = [ds.items[i] for i in sel.fit]

@@ -36,7 +36,8 @@ class Problem:
     `walk` (background.Background, truth mode): the floor's heading and travel random walk,
     measured under a preliminary kinematic fit; its variance joins every window's for every
     hypothesis except roughness, whose own law gives its variance (the walk is one measured
-    parameter, counted in k). Without it a floor that walks makes every window overdispersed,
+    parameter, counted in k for every hypothesis). Without it a floor that walks makes every
+    window overdispersed,
     and roughness won the ranking by soaking that up (the OptiOdom robot: 'roughness' first,
     the kinematic effects behind it)."""
 
@@ -100,33 +101,31 @@ class Problem:
         """(rows, channels) sigma^2 plus the walk's window variance (the diagonal)."""
         return np.vstack(self._var_parts({}))
 
-    def rough_cap(self) -> float:
-        """The largest roughness height the data allow: grains whose walk (catalog law, truck A's
-        wheels) is four times the walk measured on the fitting runs, driving or on the spot.
-        Roughness's variance grows with each window's travel, so uncapped it absorbed any
-        misfit that grows with speed (counts lost on a sprint, a lever arm on fast arcs) at its
-        10 mm bound, a scale error cancelling its mean; a floor that rough would walk far more
-        than the data do."""
+    def rough_from_walk(self) -> float:
+        """The roughness height (catalog law, truck A's wheels) whose grains walk as much as the
+        floor measured on the fitting runs does while driving: roughness's hypothesis is that
+        floor, its mean shortening predicted, not a free height. Free, its variance (which grows
+        with each window's travel) absorbed any misfit that grows with speed - counts lost on a
+        sprint, a lever arm on fast arcs, slip on hard starts - at its bound, a scale error
+        cancelling its mean (the independent world's labmates came out es+roughness)."""
         from .model import rough_moments
 
-        if self.walk is None or not self.walk.q_wheel:
-            return float("inf")
-        qs = [*self.walk.q_wheel, *self.walk.q_turn]
-        qs += [hi for _, hi in (*self.walk.q_wheel_ci, *self.walk.q_turn_ci)]
-        q_max = 4.0 * max(qs)
+        if self.walk is None or not self.walk.q_wheel or self.walk.q_wheel[0] <= 0:
+            return 0.0
+        q = self.walk.q_wheel[0]
         R = self.items[0].pr.R[0]
-        for h in np.linspace(0.05, 10.0, 200):
+        hs = np.linspace(0.01, 10.0, 400)
+        qs = []
+        for h in hs:
             m1, m2 = rough_moments(R, h)
-            if (m2 - m1 * m1 + m1 * m1 * 0.25 / 3.0) / 20.0 > q_max:
-                return float(max(h, 0.05))
-        return float("inf")
+            qs.append((m2 - m1 * m1 + m1 * m1 * 0.25 / 3.0) / 20.0)
+        return float(np.interp(q, qs, hs, right=10.0))
 
     def walk_k(self, P: dict) -> int:
-        """Parameters the measured walk costs a hypothesis (none for roughness, which brings its
-        own variance)."""
-        if self.walk is None or not self.walk.active:
-            return 0
-        return 0 if has_rough(P) else 1
+        """Parameters the measured walk costs a hypothesis: one, roughness included (its own
+        variance replaces the walk's; had it been free, a roughness at next to no height - the
+        nominal noise without the walk - won every tie by that parameter)."""
+        return 1 if self.walk is not None and self.walk.active else 0
 
     def deviance(self, P: dict) -> tuple[float, float, int]:
         """(-2 ln L relative to sigma, chi^2 of the whitened residuals, n scalars)."""
@@ -248,20 +247,20 @@ class Fit:
 
 
 def fit_params(
-    prob: Problem, keys: list[str], base: dict | None = None, warm: dict | None = None
+    prob: Problem,
+    keys: list[str],
+    base: dict | None = None,
+    warm: dict | None = None,
+    bnd: dict | None = None,
 ) -> tuple[dict, dict]:
     """Bounded least squares of `keys` (others from `base`). `warm`: start values (pairs start
     from their singles' fits, one start; else the catalog start and, for slip/skid, a second)."""
     base = dict(base or {})
     if not keys:
         return base, {}
-    lo, hi, x0 = zip(*(bounds(k) for k in keys), strict=False)
+    bnd = bnd or {}
+    lo, hi, x0 = zip(*(bnd.get(k) or bounds(k) for k in keys), strict=False)
     x0 = list(x0)
-    if "roughness.max_height_mm" in keys:
-        r = keys.index("roughness.max_height_mm")
-        hi = list(hi)
-        hi[r] = min(hi[r], prob.rough_cap())
-        x0[r] = min(x0[r], 0.5 * hi[r])
     if warm:
         x0 = [warm.get(k, v) for k, v in zip(keys, x0, strict=False)]
 
@@ -288,8 +287,6 @@ def fit_params(
             best = res
     P = dict(base)
     P.update(zip(keys, best.x, strict=False))
-    if "roughness.max_height_mm" in keys:
-        P = _roughness_by_likelihood(prob, P)
     se = {}
     try:
         J = best.jac
@@ -299,30 +296,6 @@ def fit_params(
     except (np.linalg.LinAlgError, ValueError):
         se = {k: float("nan") for k in keys}
     return P, se
-
-
-def _roughness_by_likelihood(prob: Problem, P: dict) -> dict:
-    """Roughness's height sets its mean (a shortening, which least squares fits) and its
-    variance (which least squares cannot see): the height is refined by the deviance itself,
-    the other parameters held. Least squares alone overshot the height on the blind check's
-    floors (1.45 mm for 1.09: more shortening of the turns for a heading misfit the variance
-    should have taken), and roughness lost to an Es plus the measured walk."""
-    from scipy.optimize import minimize_scalar
-
-    h0 = P["roughness.max_height_mm"]
-    lo, hi, _ = bounds("roughness.max_height_mm")
-
-    def dev(h: float) -> float:
-        Q = dict(P)
-        Q["roughness.max_height_mm"] = h
-        return prob.deviance(Q)[0]
-
-    a, b = max(lo, 0.3 * h0, 1e-3), min(hi, 1.5 * h0 + 0.05)
-    r = minimize_scalar(dev, bounds=(a, b), method="bounded", options={"xatol": 1e-3 * h0 + 1e-4})
-    if r.fun < dev(h0):
-        P = dict(P)
-        P["roughness.max_height_mm"] = float(r.x)
-    return P
 
 
 def evaluate(
@@ -346,10 +319,14 @@ def fit_hypothesis(
     caller has them, else detected under `base_params`, else under a fit of its other members)."""
     from .bumps import clear_bumps, cluster_bumps, detect_bumps, place_bumps
 
-    keys = hyp.params
+    keys = list(hyp.params)
     clear_bumps(prs)
+    fixed = {}
+    bnd = {}
+    if "roughness" in hyp.families:  # its height is the measured walk's (Problem.rough_from_walk)
+        fixed["roughness.max_height_mm"] = prob.rough_from_walk()
     if not hyp.has_bumps:
-        P, se = fit_params(prob, keys, warm=warm)
+        P, se = fit_params(prob, keys, fixed, warm=warm, bnd=bnd)
         return evaluate(prob, hyp.name, P, se, len(keys), hyp=hyp)
     if floor_bumps is not None:
         fb = floor_bumps
@@ -359,7 +336,7 @@ def fit_hypothesis(
             P0 = dict(base_params) if base_params is not None else fit_params(prob, keys)[0]
         fb = cluster_bumps(detect_bumps(prob.items, P0, sig_head))
     place_bumps(prs, fb, own=True)
-    P, se = fit_params(prob, keys, {}, warm=warm) if keys else ({}, {})
+    P, se = fit_params(prob, keys, dict(fixed), warm=warm, bnd=bnd) if keys else (dict(fixed), {})
     h = float(np.median([b["h"] for b in fb])) if fb else 0.0
     P = dict(P)
     P["bumps.height_mm"] = h

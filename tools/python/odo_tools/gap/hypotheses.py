@@ -19,7 +19,7 @@ CATALOG_FREE = {
     "ed": ("value",),
     "eb": ("value",),
     "es": ("value",),
-    "roughness": ("max_height_mm",),
+    "roughness": (),  # its height follows from the measured walk (fit.Problem.rough_from_walk)
     "slip": ("k_per_m_s2", "tau_s"),
     "skid": ("k_s",),
     "rotary_bias": ("alpha_deg", "beta_deg"),
