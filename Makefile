@@ -4,10 +4,10 @@ SHELL := /bin/bash
 .DEFAULT_GOAL := help
 JOBS ?= $(shell nproc)
 
-.PHONY: help deps build release cm4 test demo bench soak clean
+.PHONY: help deps build release cm4 test demo bench bench-target soak flash flash-params flash-all package lock clean
 
 help: ## list targets
-	@grep -E '^[a-z0-9-]+:.*## ' $(MAKEFILE_LIST) | awk -F':.*## ' '{printf "  make %-8s %s\n", $$1, $$2}'
+	@grep -E '^[a-z0-9-]+:.*## ' $(MAKEFILE_LIST) | awk -F':.*## ' '{printf "  make %-12s %s\n", $$1, $$2}'
 
 deps: ## install Debian packages and the pinned Python venv (.venv)
 	@bash tools/deps.sh
@@ -33,8 +33,27 @@ demo: build ## run the main job on built-in sample data
 bench: release ## print benchmark figures as JSON (-O2 build: build/release/bin/odo-bench --json)
 	@build/release/bin/odo-bench --json
 
+bench-target: release cm4 ## Cortex-M4 figures as JSON: instructions per tick (emulated), flash, RAM, stack
+	@.venv/bin/odo-bench-target --build-dir build/release --cm4-dir build/cm4
+
+flash: cm4 ## program the image with openocd, never its parameter sector (odo-flash code)
+	@.venv/bin/odo-flash code --image build/cm4/bin/odo_image.elf
+
+flash-params: cm4 ## program only the parameter block: make flash-params PARAMS=fw.elf|fw.hex|block.bin
+	@.venv/bin/odo-flash params --image build/cm4/bin/odo_image.elf --params "$(PARAMS)"
+
+flash-all: cm4 ## program image and its default parameter block (erases a calibrated block)
+	@.venv/bin/odo-flash all --image build/cm4/bin/odo_image.elf
+
 soak: release ## frame loss at speed and the 24 h fault soak, JSON (build/release/bin/odo-soak --json)
 	@build/release/bin/odo-soak --json
+
+package: release ## the .deb (CPack, release build) and the wheel, in build/release/package
+	@cd build/release && cpack -G DEB -B package >/dev/null && ls package/*.deb
+	@bash tools/python/wheel.sh build/release/package
+
+lock: ## re-compile tools/python/requirements.txt (hash-pinned) from pyproject.toml; needs PyPI
+	@bash tools/python/lock.sh
 
 clean: ## remove build output (keeps .venv)
 	rm -rf build

@@ -23,7 +23,10 @@ static void reset_poses(odo_app_t *app)
 
 static bool init_models(odo_app_t *app, const odo_params_t *p)
 {
-    for (uint8_t i = 0U; i < ODO_TRUCKS; ++i) {
+    /* Only the trucks the vehicle has: a single truck's unused record B keeps the defaults, whose
+     * count rate need not fit a narrow counter (a 12-bit decoder on a 50 ms robot). */
+    const uint8_t n = (p->vehicle == (uint8_t)ODO_VEHICLE_SINGLE) ? 1U : ODO_TRUCKS;
+    for (uint8_t i = 0U; i < n; ++i) {
         if (odo_model_init(&app->model[i], &p->truck[i], p->counter_bits, p->heading_form, p->tick_us,
                            p->max_wheel_speed_mm_s) != ODO_MODEL_OK) {
             return false;

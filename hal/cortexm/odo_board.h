@@ -10,6 +10,8 @@
 #include <stdint.h>
 
 #include "odo/odo_params.h"
+#include "odo_board_port.h"
+#include "odo_selftest.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -22,21 +24,14 @@ extern "C" {
 /// so the compiler can never fold its contents into main(): the firmware reads what is in flash.
 extern const uint8_t odo_param_block[ODO_PARAMS_SIZE];
 
-/// Result of the boot self-test in main(), kept in RAM for a debugger or a later qemu test to read
-/// (symbol odo_board_selftest). `done` becomes ODO_BOARD_SELFTEST_DONE once all fields are final.
-typedef struct {
-    uint32_t params_status; ///< odo_params_status_t of odo_app_init on odo_param_block (0: OK)
-    uint32_t steps;         ///< synthetic ticks run through odo_app_step
-    uint32_t faults_or;     ///< OR of the ODO_FAULT_* bits every step raised
-    uint32_t frames;        ///< output frames produced in total
-    int64_t  x_mm_q32;      ///< final pose of truck A (odo_pose_t units)
-    int64_t  y_mm_q32;
-    uint32_t heading_bam;   ///< top 32 bits of the final heading_q64 of truck A
-    uint32_t done;          ///< ODO_BOARD_SELFTEST_DONE when the above are complete
-} odo_board_selftest_t;
+/// The board's peripherals and pins (odo_board_config.c).
+extern const odo_board_config_t odo_board_config;
 
-#define ODO_BOARD_SELFTEST_DONE 0x600DF00DUL
+/// What start-up found and the loop's counters (odo_board_port.h), refreshed every tick.
+extern volatile odo_board_status_t odo_board_status;
 
+/// Result of the boot self-test (odo_selftest.h), kept in RAM for a debugger and for
+/// tests/target, which reads it under qemu and compares it with the host's.
 extern volatile odo_board_selftest_t odo_board_selftest;
 
 /// Exception entry points named as in CMSIS, so a later CMSIS/HAL backend can override the weak

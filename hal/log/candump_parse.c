@@ -155,7 +155,31 @@ candump_result_t candump_parse_line(const char *line, size_t len, candump_line_t
     p++; /* '#' */
 
     if (p < end && *p == '#') {
-        FAIL("CAN FD frame ('##'): only classic CAN is supported");
+        /* CAN FD: "##" flags-digit data (0..64 bytes). Well-formed ones are another node's traffic
+         * on a mixed bus: reported as CANDUMP_FD so a reader counts and skips them. */
+        p++;
+        if (p >= end || hexval(*p) < 0) {
+            FAIL("CAN FD frame ('##') without its flags digit");
+        }
+        p++;
+        size_t fd_digits = 0;
+        while (p < end && *p != ' ') {
+            if (hexval(*p) < 0) {
+                FAIL("CAN FD frame: data must be hex digits");
+            }
+            fd_digits++;
+            p++;
+        }
+        if (fd_digits % 2U != 0U || fd_digits > 128U) {
+            FAIL("CAN FD frame: odd number of hex digits or more than 64 data bytes");
+        }
+        if (end - p == 2 && p[0] == ' ' && (p[1] == 'R' || p[1] == 'T')) {
+            p += 2;
+        }
+        if (p != end) {
+            FAIL("unexpected text after the CAN FD frame");
+        }
+        return CANDUMP_FD;
     }
     if (p < end && (*p == 'R' || *p == 'r')) {
         if ((out->frame.flags & ODO_CAN_FLAG_ERR) != 0U) {

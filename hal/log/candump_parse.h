@@ -15,7 +15,10 @@
 ///   data      = 0..8 bytes, two hex digits each (either case), optionally separated by "."
 ///   dlc       = one decimal digit 0..8 (RTR frames only; data bytes stay zero)
 ///
-/// Rejected with a message that says why: CAN FD ("##"), CAN XL, more than 8 data bytes, an odd
+/// CAN FD lines ("##" flags digit, 0..64 data bytes, optional " R"/" T") are another node's traffic
+/// on a mixed bus: CANDUMP_FD, so readers count and skip them (t_us and iface are filled).
+///
+/// Rejected with a message that says why: a malformed CAN FD line, CAN XL, more than 8 data bytes, an odd
 /// hex digit, an identifier of another width, a standard identifier above 0x7FF, identifier bits
 /// 30..31 set, a malformed timestamp, anything after the frame but " R"/" T". Blank lines are
 /// reported as CANDUMP_BLANK, so a reader can skip them.
@@ -37,7 +40,8 @@ extern "C" {
 typedef enum {
     CANDUMP_OK = 0, ///< *frame, *t_us, iface written
     CANDUMP_BLANK,  ///< empty or whitespace-only line; outputs untouched
-    CANDUMP_ERR     ///< malformed; *why names the problem (static string); outputs unspecified
+    CANDUMP_ERR,    ///< malformed; *why names the problem (static string); outputs unspecified
+    CANDUMP_FD      ///< a well-formed CAN FD line: not a classic frame; t_us and iface written
 } candump_result_t;
 
 /// One parsed line, as the log wrote it.

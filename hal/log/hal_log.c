@@ -98,6 +98,10 @@ hal_log_status_t hal_log_next(hal_log_t *l, candump_line_t *out)
             l->stats.blank++;
             continue;
         }
+        if (r == CANDUMP_FD) {
+            l->stats.fd_skipped++;
+            continue;
+        }
         if (r != CANDUMP_OK) {
             snprintf(l->err, sizeof l->err, "%s:%llu: %s", l->path, (unsigned long long)l->line_no, why);
             return HAL_LOG_ERROR;

@@ -35,6 +35,7 @@ typedef struct {
     uint64_t lines;        ///< lines read, blank ones included
     uint64_t frames;       ///< frames returned
     uint64_t blank;        ///< blank lines skipped
+    uint64_t fd_skipped;   ///< CAN FD lines ("##") skipped: another node's traffic
     uint64_t error_frames; ///< frames with ODO_CAN_FLAG_ERR
     uint64_t rtr_frames;   ///< frames with ODO_CAN_FLAG_RTR
     uint64_t ext_frames;   ///< frames with ODO_CAN_FLAG_EXT
@@ -55,7 +56,7 @@ typedef struct {
 /// Open `path` ("-" is stdin). Returns 0, or -1 with l->err set (cannot open, out of memory).
 int hal_log_open(hal_log_t *l, const char *path);
 
-/// Next frame of the log (blank lines skipped). Returns HAL_LOG_ERROR on the first malformed line
+/// Next frame of the log (blank and CAN FD lines skipped and counted). Returns HAL_LOG_ERROR on the first malformed line
 /// (err: "PATH:LINE: why"), on a read error, and on a line longer than HAL_LOG_CHUNK. O(line).
 hal_log_status_t hal_log_next(hal_log_t *l, candump_line_t *out);
 

@@ -1,6 +1,8 @@
 /// Robot description JSON reader and conversion to odo_params_t; see robot.h for the schema.
 #include "robot.h"
 
+#include "odo/odo_odometry.h"
+
 #include <errno.h>
 #include <jansson.h>
 #include <math.h>
@@ -87,6 +89,63 @@ int sim_robot_default(sim_vehicle_t v, sim_robot_t *r)
     r->set.trailer_length_mm = 500.0;
     return 0;
 }
+
+/* ---------------------------------------------------------------------------------------------
+ * THE limits of the robot description, one row per numeric key: the C tools parse with them and
+ * the Python package reads the same parse through libodosim (odosim_robot_describe), so no second
+ * copy exists to drift. Truck ranges are the firmware's (odo_params.h) so a file that parses also
+ * validates.
+ * ------------------------------------------------------------------------------------------- */
+static const sim_robot_limit_t k_limits[] = {
+    {"tick_ms", 1.0, 1000.0, "ms"},
+    {"max_wheel_speed_mm_s", 100.0, 20000.0, "mm/s"},
+    {"trucks.*.wheel_diameter_mm", 10.0, 2000.0, "mm"},
+    {"trucks.*.wheelbase_mm", 50.0, 3000.0, "mm"},
+    {"trucks.*.encoder_lines", 1.0, 1000000.0, "lines per turn"},
+    {"trucks.*.gear_ratio", 0.01, 10000.0, "motor turns per wheel turn"},
+    {"trucks.*.counter_bits", 8.0, 32.0, "bit"}, /* what real decoders have: HCTL 8/16/24, MCU timers 16/32 */
+    {"trucks.*.calibration.ed", 0.8, 1.25, ""},
+    {"trucks.*.calibration.eb", 0.8, 1.25, ""},
+    {"trucks.*.calibration.es", 0.8, 1.25, ""},
+    {"trucks.*.calibration.scrub", -0.25, 0.25, ""},
+    {"linkage.length_mm", 100.0, 4000.0, "mm"},
+    {"linkage.rotary_bits", 8.0, 16.0, "bit"},
+    {"linkage.linear_resolution_mm", 0.001, 10.0, "mm"},
+    {"linkage.calibration.length_bias_mm", -50.0, 50.0, "mm"},
+    {"linkage.calibration.length_ecc_mm", -50.0, 50.0, "mm"},
+    {"linkage.calibration.alpha_bias_deg", -10.0, 10.0, "deg"},
+    {"linkage.calibration.beta_bias_deg", -10.0, 10.0, "deg"},
+    {"trailer.hitch_offset_mm", 0.0, 4000.0, "mm"},
+    {"trailer.trailer_length_mm", 100.0, 4000.0, "mm"},
+    {"trailer.rotary_bits", 8.0, 16.0, "bit"},
+    {"trailer.calibration.alpha_bias_deg", -10.0, 10.0, "deg"},
+};
+
+const sim_robot_limit_t *sim_robot_limits(size_t *n)
+{
+    *n = sizeof k_limits / sizeof k_limits[0];
+    return k_limits;
+}
+
+/* The row of `key` ("trucks.A.x" matches "trucks.*.x"); a missing row is a programming error. */
+static const sim_robot_limit_t *lim(const char *path, const char *key)
+{
+    char full[160];
+    snprintf(full, sizeof full, "%s%s%s", path, path[0] ? "." : "", key);
+    if (strncmp(full, "trucks.", 7) == 0 && full[7] != '\0' && full[8] == '.') {
+        full[7] = '*';
+    }
+    for (size_t i = 0; i < sizeof k_limits / sizeof k_limits[0]; ++i) {
+        if (strcmp(k_limits[i].key, full) == 0) {
+            return &k_limits[i];
+        }
+    }
+    static const sim_robot_limit_t none = {"", 0.0, -1.0, ""};
+    return &none; /* empty range: every value fails, loudly, in the tests */
+}
+
+#define LO(path, key) lim(path, key)->lo
+#define HI(path, key) lim(path, key)->hi
 
 /* ---------------------------------------------------------------------------------------------
  * JSON helpers. Each names "<origin>: <field>: <why>".
@@ -262,13 +321,12 @@ static int parse_truck(const ctx_t *c, const json_t *o, const char *path, sim_tr
     static const char *const decoders[] = {"hctl1100", "hctl20xx", NULL};
     static const char *const cal_keys[] = {"ed", "eb", "es", "scrub", NULL};
     unsigned dec = (unsigned)t->decoder;
-    /* Ranges are the firmware's (odo_params.h) so a file that parses also validates. */
     if (only_keys(c, o, path, keys) != 0 ||
-        get_num(c, o, path, "wheel_diameter_mm", true, 10.0, 2000.0, &t->wheel_diameter_mm) != 0 ||
-        get_num(c, o, path, "wheelbase_mm", true, 50.0, 3000.0, &t->wheelbase_mm) != 0 ||
-        get_uint(c, o, path, "encoder_lines", true, 1U, 1000000U, &t->encoder_lines) != 0 ||
-        get_num(c, o, path, "gear_ratio", true, 0.01, 10000.0, &t->gear_ratio) != 0 ||
-        get_uint(c, o, path, "counter_bits", false, 16U, 32U, &t->counter_bits) != 0 ||
+        get_num(c, o, path, "wheel_diameter_mm", true, LO(path, "wheel_diameter_mm"), HI(path, "wheel_diameter_mm"), &t->wheel_diameter_mm) != 0 ||
+        get_num(c, o, path, "wheelbase_mm", true, LO(path, "wheelbase_mm"), HI(path, "wheelbase_mm"), &t->wheelbase_mm) != 0 ||
+        get_uint(c, o, path, "encoder_lines", true, (unsigned)LO(path, "encoder_lines"), (unsigned)HI(path, "encoder_lines"), &t->encoder_lines) != 0 ||
+        get_num(c, o, path, "gear_ratio", true, LO(path, "gear_ratio"), HI(path, "gear_ratio"), &t->gear_ratio) != 0 ||
+        get_uint(c, o, path, "counter_bits", false, (unsigned)LO(path, "counter_bits"), (unsigned)HI(path, "counter_bits"), &t->counter_bits) != 0 ||
         get_choice(c, o, path, "decoder", false, decoders, &dec) != 0 ||
         get_bool(c, o, path, "invert_left", &t->invert_left) != 0 ||
         get_bool(c, o, path, "invert_right", &t->invert_right) != 0) {
@@ -276,10 +334,6 @@ static int parse_truck(const ctx_t *c, const json_t *o, const char *path, sim_tr
     }
     t->decoder = (sim_decoder_t)dec;
     char f[160];
-    if (t->counter_bits != 16U && t->counter_bits != 24U && t->counter_bits != 32U) {
-        field(f, sizeof f, path, "counter_bits");
-        return fail(c, f, "%u is not 16, 24 or 32", t->counter_bits);
-    }
     const double cpr = sim_robot_counts_per_rev(t);
     if (cpr < 100.0 || cpr > 4.0e6) {
         field(f, sizeof f, path, "encoder_lines");
@@ -291,11 +345,11 @@ static int parse_truck(const ctx_t *c, const json_t *o, const char *path, sim_tr
     }
     if (cal != NULL) {
         field(f, sizeof f, path, "calibration");
-        if (only_keys(c, cal, f, cal_keys) != 0 || get_num(c, cal, f, "ed", false, 0.8, 1.25, &t->cal_ed) != 0 ||
-            get_num(c, cal, f, "eb", false, 0.8, 1.25, &t->cal_eb) != 0 ||
-            get_num(c, cal, f, "es", false, 0.8, 1.25, &t->cal_es) != 0 ||
+        if (only_keys(c, cal, f, cal_keys) != 0 || get_num(c, cal, f, "ed", false, LO(f, "ed"), HI(f, "ed"), &t->cal_ed) != 0 ||
+            get_num(c, cal, f, "eb", false, LO(f, "eb"), HI(f, "eb"), &t->cal_eb) != 0 ||
+            get_num(c, cal, f, "es", false, LO(f, "es"), HI(f, "es"), &t->cal_es) != 0 ||
             /* k of the firmware's tyre-scrub term (odo_odometry.h): |k| <= 0.25, as the block */
-            get_num(c, cal, f, "scrub", false, -0.25, 0.25, &t->cal_scrub) != 0) {
+            get_num(c, cal, f, "scrub", false, LO(f, "scrub"), HI(f, "scrub"), &t->cal_scrub) != 0) {
             return -1;
         }
         t->has_calibration = true;
@@ -328,10 +382,10 @@ static int parse_root(const ctx_t *c, const json_t *root, sim_robot_t *r)
         }
         snprintf(r->description, sizeof r->description, "%s", json_string_value(d));
     }
-    if (get_num(c, root, "", "tick_ms", false, 1.0, 1000.0, &r->tick_ms) != 0 ||
+    if (get_num(c, root, "", "tick_ms", false, LO("", "tick_ms"), HI("", "tick_ms"), &r->tick_ms) != 0 ||
         get_choice(c, root, "", "heading_form", false, forms, &r->heading_form) != 0 ||
         get_choice(c, root, "", "ipec", false, ipec, &r->ipec_mode) != 0 ||
-        get_num(c, root, "", "max_wheel_speed_mm_s", false, 100.0, 20000.0, &r->max_wheel_speed_mm_s) != 0) {
+        get_num(c, root, "", "max_wheel_speed_mm_s", false, LO("", "max_wheel_speed_mm_s"), HI("", "max_wheel_speed_mm_s"), &r->max_wheel_speed_mm_s) != 0) {
         return -1;
     }
     if (fabs(r->tick_ms * 1000.0 - round(r->tick_ms * 1000.0)) > 1e-6) {
@@ -370,9 +424,9 @@ static int parse_root(const ctx_t *c, const json_t *root, sim_robot_t *r)
                                          "beta_bias_deg", NULL};
         const json_t *cal = NULL;
         if (get_obj(c, root, "", "linkage", true, &link) != 0 || only_keys(c, link, "linkage", lk) != 0 ||
-            get_num(c, link, "linkage", "length_mm", true, 100.0, 4000.0, &r->link.length_mm) != 0 ||
-            get_uint(c, link, "linkage", "rotary_bits", false, 8U, 16U, &r->link.rotary_bits) != 0 ||
-            get_num(c, link, "linkage", "linear_resolution_mm", false, 0.001, 10.0,
+            get_num(c, link, "linkage", "length_mm", true, LO("linkage", "length_mm"), HI("linkage", "length_mm"), &r->link.length_mm) != 0 ||
+            get_uint(c, link, "linkage", "rotary_bits", false, (unsigned)LO("linkage", "rotary_bits"), (unsigned)HI("linkage", "rotary_bits"), &r->link.rotary_bits) != 0 ||
+            get_num(c, link, "linkage", "linear_resolution_mm", false, LO("linkage", "linear_resolution_mm"), HI("linkage", "linear_resolution_mm"),
                     &r->link.linear_resolution_mm) != 0 ||
             get_obj(c, link, "linkage", "calibration", false, &cal) != 0) {
             return -1;
@@ -394,13 +448,13 @@ static int parse_root(const ctx_t *c, const json_t *root, sim_robot_t *r)
             }
         }
         if (cal != NULL && (only_keys(c, cal, "linkage.calibration", ck) != 0 ||
-                            get_num(c, cal, "linkage.calibration", "length_bias_mm", false, -50.0, 50.0,
+                            get_num(c, cal, "linkage.calibration", "length_bias_mm", false, LO("linkage.calibration", "length_bias_mm"), HI("linkage.calibration", "length_bias_mm"),
                                     &r->link.cal_length_bias_mm) != 0 ||
-                            get_num(c, cal, "linkage.calibration", "length_ecc_mm", false, -50.0, 50.0,
+                            get_num(c, cal, "linkage.calibration", "length_ecc_mm", false, LO("linkage.calibration", "length_ecc_mm"), HI("linkage.calibration", "length_ecc_mm"),
                                     &r->link.cal_length_ecc_mm) != 0 ||
-                            get_num(c, cal, "linkage.calibration", "alpha_bias_deg", false, -10.0, 10.0,
+                            get_num(c, cal, "linkage.calibration", "alpha_bias_deg", false, LO("linkage.calibration", "alpha_bias_deg"), HI("linkage.calibration", "alpha_bias_deg"),
                                     &r->link.cal_alpha_bias_deg) != 0 ||
-                            get_num(c, cal, "linkage.calibration", "beta_bias_deg", false, -10.0, 10.0,
+                            get_num(c, cal, "linkage.calibration", "beta_bias_deg", false, LO("linkage.calibration", "beta_bias_deg"), HI("linkage.calibration", "beta_bias_deg"),
                                     &r->link.cal_beta_bias_deg) != 0)) {
             return -1;
         }
@@ -410,14 +464,14 @@ static int parse_root(const ctx_t *c, const json_t *root, sim_robot_t *r)
         static const char *const ck[] = {"alpha_bias_deg", NULL};
         const json_t *cal = NULL;
         if (get_obj(c, root, "", "trailer", true, &trailer) != 0 || only_keys(c, trailer, "trailer", tk) != 0 ||
-            get_num(c, trailer, "trailer", "hitch_offset_mm", true, 0.0, 4000.0, &r->set.hitch_offset_mm) != 0 ||
-            get_num(c, trailer, "trailer", "trailer_length_mm", true, 100.0, 4000.0, &r->set.trailer_length_mm) != 0 ||
-            get_uint(c, trailer, "trailer", "rotary_bits", false, 8U, 16U, &r->link.rotary_bits) != 0 ||
+            get_num(c, trailer, "trailer", "hitch_offset_mm", true, LO("trailer", "hitch_offset_mm"), HI("trailer", "hitch_offset_mm"), &r->set.hitch_offset_mm) != 0 ||
+            get_num(c, trailer, "trailer", "trailer_length_mm", true, LO("trailer", "trailer_length_mm"), HI("trailer", "trailer_length_mm"), &r->set.trailer_length_mm) != 0 ||
+            get_uint(c, trailer, "trailer", "rotary_bits", false, (unsigned)LO("trailer", "rotary_bits"), (unsigned)HI("trailer", "rotary_bits"), &r->link.rotary_bits) != 0 ||
             get_obj(c, trailer, "trailer", "calibration", false, &cal) != 0) {
             return -1;
         }
         if (cal != NULL && (only_keys(c, cal, "trailer.calibration", ck) != 0 ||
-                            get_num(c, cal, "trailer.calibration", "alpha_bias_deg", false, -10.0, 10.0,
+                            get_num(c, cal, "trailer.calibration", "alpha_bias_deg", false, LO("trailer.calibration", "alpha_bias_deg"), HI("trailer.calibration", "alpha_bias_deg"),
                                     &r->link.cal_alpha_bias_deg) != 0)) {
             return -1;
         }
@@ -579,6 +633,29 @@ int sim_robot_to_params(const sim_robot_t *r, odo_params_t *p, char *err, size_t
         snprintf(f, sizeof f, "%s%s%s", truck_field ? "trucks." : "",
                  truck_field ? (bad_truck == 0U ? "A." : "B.") : "", json_field(r, bad));
         return fail(&c, f, "rejected by odo_params_validate (parameter block field %d out of range)", (int)bad);
+    }
+    /* A block that validates must also boot: the firmware's per-truck multipliers must fit, and a
+     * counter must not wrap within one tick at the top wheel speed (odo_model_init). */
+    for (unsigned t = 0; t < r->n_trucks && t < ODO_TRUCKS; ++t) {
+        odo_model_t m;
+        if (odo_model_init(&m, &p->truck[t], p->counter_bits, p->heading_form, p->tick_us,
+                           p->max_wheel_speed_mm_s) != ODO_MODEL_OK) {
+            const sim_truck_desc_t *d = &r->truck[t];
+            const double per_tick = r->max_wheel_speed_mm_s * r->tick_ms * 1e-3 /
+                                    (M_PI * d->wheel_diameter_mm / sim_robot_counts_per_rev(d));
+            char f[64];
+            if (per_tick + 1.0 >= ldexp(1.0, (int)d->counter_bits - 1)) {
+                snprintf(f, sizeof f, "trucks.%c.counter_bits", t == 0U ? 'A' : 'B');
+                return fail(&c, f, "%u-bit counters wrap within one %g ms tick at max_wheel_speed_mm_s %g "
+                            "(%.0f counts per tick; the firmware needs fewer than %.0f)", d->counter_bits,
+                            r->tick_ms, r->max_wheel_speed_mm_s, per_tick, ldexp(1.0, (int)d->counter_bits - 1));
+            }
+            const double turns = 2.0 * r->max_wheel_speed_mm_s * r->tick_ms * 1e-3 / d->wheelbase_mm / (2.0 * M_PI);
+            snprintf(f, sizeof f, "trucks.%c", t == 0U ? 'A' : 'B');
+            return fail(&c, f, "geometry beyond the firmware's fixed-point formats (odo_model_init): at "
+                        "max_wheel_speed_mm_s %g a %g ms tick may turn %.3g turns with wheelbase_mm %g",
+                        r->max_wheel_speed_mm_s, r->tick_ms, turns, d->wheelbase_mm);
+        }
     }
     return 0;
 }

@@ -49,7 +49,7 @@ typedef struct {
     double        wheelbase_mm;      ///< nominal b
     unsigned      encoder_lines;     ///< lines per motor (or wheel) revolution, Ce
     double        gear_ratio;        ///< n, motor turns per wheel turn
-    unsigned      counter_bits;      ///< 16, 24 or 32
+    unsigned      counter_bits;      ///< 8..32 (robot.c limits; the firmware decides what it runs)
     sim_decoder_t decoder;
     bool          invert_left;       ///< left counter counts down when the wheel rolls forward
     bool          invert_right;
@@ -80,6 +80,18 @@ typedef struct {
         double trailer_length_mm; ///< joint to the trailer axle centre
     } set;
 } sim_robot_t;
+
+/// One numeric key of the description and its inclusive range: THE limits (robot.c's table), used
+/// by the parser and handed to Python through libodosim. Keys are dotted paths; "trucks.*." stands
+/// for either truck.
+typedef struct {
+    const char *key;
+    double      lo, hi;
+    const char *unit;
+} sim_robot_limit_t;
+
+/// The table and its length. Never fails; static storage.
+const sim_robot_limit_t *sim_robot_limits(size_t *n);
 
 /// Decoded counts per wheel turn: 4 * lines * gear.
 double sim_robot_counts_per_rev(const sim_truck_desc_t *t);

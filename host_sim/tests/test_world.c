@@ -652,8 +652,8 @@ START_TEST(bad_robot_descriptions_are_refused_with_the_field_named)
     expect_robot_error("{\"vehicle\": \"tank\"}", (const char *const[]){"robot.json", "vehicle", "\"tank\"", NULL});
     expect_robot_error("{\"vehicle\": \"labmate\", \"trucks\": {\"A\": {\"wheelbase_mm\": 340}}}",
                        (const char *const[]){"trucks.A.wheel_diameter_mm", "missing", NULL});
-    expect_robot_error("{\"vehicle\": \"labmate\", \"trucks\": {\"A\": " TRUCK ", \"counter_bits\": 20}}}",
-                       (const char *const[]){"trucks.A.counter_bits", "16, 24 or 32", NULL});
+    expect_robot_error("{\"vehicle\": \"labmate\", \"trucks\": {\"A\": " TRUCK ", \"counter_bits\": 7}}}",
+                       (const char *const[]){"trucks.A.counter_bits", "out of range [8, 32]", NULL});
     expect_robot_error("{\"vehicle\": \"labmate\", \"trucks\": {\"A\": " TRUCK ", \"wheelbase\": 3}}}",
                        (const char *const[]){"trucks.A.wheelbase", "unknown key", NULL});
     expect_robot_error("{\"vehicle\": \"labmate\", \"trucks\": {\"A\": {\"wheel_diameter_mm\": 150, "

@@ -65,6 +65,12 @@ START_TEST(extended_empty_rtr_error_and_direction)
     ck_assert_uint_eq(l.frame.dlc, 3U);
     ck_assert_uint_eq(l.frame.data[2], 0x33U);
 
+    /* Another node's CAN FD frame on a mixed bus, and python-can's trailing direction. */
+    ck_assert_int_eq(parse("(1.000000) can0 123##1112233", &l, &why), CANDUMP_FD);
+    ck_assert_int_eq(parse("(2.000000) can1 12345678##0AABB R", &l, &why), CANDUMP_FD);
+    ck_assert_int_eq(parse("(1.000000) can0 110#0011 T", &l, &why), CANDUMP_OK);
+    ck_assert_int_eq(l.direction, 'T');
+
     ck_assert_int_eq(parse("   \r\n", &l, &why), CANDUMP_BLANK);
     ck_assert_int_eq(parse("", &l, &why), CANDUMP_BLANK);
 }
@@ -77,8 +83,10 @@ typedef struct {
 } bad_t;
 
 static const bad_t BAD[] = {
-    {"(1.000000) can0 123##1112233", "CAN FD"},
-    {"(1.000000) can0 12345678##0aa", "CAN FD"},
+    {"(1.000000) can0 123##", "flags digit"},
+    {"(1.000000) can0 123##1112", "odd number"},
+    {"(1.000000) can0 12345678##0aX", "hex digits"},
+    {"(1.000000) can0 123##100 X", "after the CAN FD"},
     {"(1.000000) can0 123#00112233445566778899", "more than 8"},
     {"(1.000000) can0 123#0", "odd"},
     {"(1.000000) can0 123#0G", "hex"},
@@ -126,7 +134,7 @@ START_TEST(reader_names_file_and_line)
     char path[64];
     snprintf(path, sizeof path, "/tmp/odo-test-log-%ld.log", (long)getpid());
     write_file(path, "(0.000000) can0 110#0000000000000000\n\n(0.040000) can0 111#0000000000000000\n"
-                     "(0.080000) can0 120##0000\n(0.120000) can0 121#000000000000\n");
+                     "(0.080000) can0 120##10011\n(0.120000) can0 121#000000000000\n(0.16) can0 12#00\n");
     static hal_log_t l;
     ck_assert_int_eq(hal_log_open(&l, path), 0);
     candump_line_t line;
@@ -134,9 +142,12 @@ START_TEST(reader_names_file_and_line)
     ck_assert_int_eq(hal_log_next(&l, &line), HAL_LOG_FRAME); /* blank line 2 skipped */
     ck_assert_uint_eq(line.frame.id, 0x111U);
     ck_assert_uint_eq(l.line_no, 3U);
+    ck_assert_int_eq(hal_log_next(&l, &line), HAL_LOG_FRAME); /* CAN FD line 4 counted and skipped */
+    ck_assert_uint_eq(line.frame.id, 0x121U);
+    ck_assert_uint_eq(l.stats.fd_skipped, 1U);
     ck_assert_int_eq(hal_log_next(&l, &line), HAL_LOG_ERROR);
     char want[96];
-    snprintf(want, sizeof want, "%s:4: CAN FD", path);
+    snprintf(want, sizeof want, "%s:6: identifier", path);
     ck_assert_msg(strstr(l.err, want) != NULL, "error '%s' lacks '%s'", l.err, want);
     ck_assert_uint_eq(l.stats.blank, 1U);
     hal_log_close(&l);

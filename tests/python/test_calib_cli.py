@@ -355,6 +355,24 @@ def test_export_ros2_multipliers(calibrated_params: Path) -> None:
     assert r.returncode == 2 and "ros1" in r.stderr
 
 
+def test_export_ros2_controller_name_and_absolute_values(calibrated_params: Path) -> None:
+    """Issue 14 item 5: the user's controller name, absolute separation and radius beside the
+    multipliers (the labmate of calibrated_params: b 340 mm, D 150 mm)."""
+    r = run(CALIB, "export", "--params", calibrated_params, "--format", "ros2",
+            "--controller-name", "base_controller")
+    assert r.returncode == 0, r.stderr
+    lines = r.stdout.splitlines()
+    assert "base_controller:" in lines and "diff_drive_controller:" not in lines
+    vals = {k.strip(): float(v) for k, _, v in (ln.partition(":") for ln in lines
+            if ln.startswith("    "))}
+    assert vals["wheel_separation"] == pytest.approx(0.340, abs=1e-9)
+    assert vals["wheel_radius"] == pytest.approx(0.075, abs=1e-9)
+    assert "scrub" in r.stdout   # the extra model parameter is documented where it is dropped
+    r = run(CALIB, "export", "--params", calibrated_params, "--format", "ros2",
+            "--controller-name", "9 bad")
+    assert r.returncode == 2 and "not a ROS 2 node name" in r.stderr
+
+
 def test_acceptance_seeded_subset_meets_the_targets() -> None:
     """The issue's acceptance on 8 seeded robots (the full run: `odo-calib acceptance --robots 20
     --seed 1`): exact method median improvement >= 20x, >= 95 % within 3 SEM after one pass,

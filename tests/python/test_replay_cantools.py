@@ -113,7 +113,7 @@ GOOD = [f"({k * 0.04:.6f}) can0 110#{k:02X}0000{k:02X}0000{k:02X}00" for k in ra
 
 
 @pytest.mark.parametrize(("line", "why"), [
-    ("(0.200000) can0 110##10000000000000000", "CAN FD"),
+    ("(0.200000) can0 110##1000", "CAN FD"),   # malformed; a well-formed one is skipped
     ("(0.200000) can0 110#000000000000000000", "more than 8 data bytes"),
     ("(0.200000) can0 110#0", "odd number"),
     ("0.200000 can0 110#00", "timestamp"),

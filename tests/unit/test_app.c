@@ -430,6 +430,24 @@ static void twelve_bit_counters_wrap_both_ways_through_the_app(void)
     TEST_ASSERT_EQUAL_UINT8(12U, app.params.counter_bits);
 }
 
+/// A single truck boots on a narrow counter that only its own record fits: the unused record B
+/// (the defaults, a labmate whose 3 m/s in 40 ms is ~9900 counts) is not a model the app runs.
+/// The same record B on a clapper, which does run it, is refused.
+static void unused_truck_record_does_not_stop_a_single_truck_from_booting(void)
+{
+    odo_params_t p;
+    odo_params_defaults(&p);
+    p.counter_bits = 12U;
+    p.tick_us = 50000U;                          /* OptiOdom: D 84 mm, 2796.8 counts/turn */
+    p.truck[0].wheel_diameter_nm = 84000000U;
+    p.truck[0].counts_per_rev_milli = 2796800U;
+    p.truck[0].wheelbase_nm = 200000000U;
+    TEST_ASSERT_EQUAL(ODO_PARAMS_OK, odo_app_init_params(&app, &p));
+    TEST_ASSERT_EQUAL_UINT8(12U, app.params.counter_bits);
+    p.vehicle = (uint8_t)ODO_VEHICLE_CLAPPER;
+    TEST_ASSERT_EQUAL(ODO_PARAMS_ERR_RANGE, odo_app_init_params(&app, &p));
+}
+
 int main(void)
 {
     UNITY_BEGIN();
@@ -447,5 +465,6 @@ int main(void)
     RUN_TEST(a_pose_beyond_the_integrable_range_is_held_and_flagged);
     RUN_TEST(a_pose_beyond_the_pose_xy_frame_is_flagged);
     RUN_TEST(twelve_bit_counters_wrap_both_ways_through_the_app);
+    RUN_TEST(unused_truck_record_does_not_stop_a_single_truck_from_booting);
     return UNITY_END();
 }

@@ -1,6 +1,8 @@
 /// Wide-integer helpers of odo_fx.h: exact products, rounded quotients, rounding shifts, checked
-/// against 128-bit host arithmetic where the compiler has it (on a 32-bit target those comparisons
-/// are skipped and the identity checks still run).
+/// against a portable 128-bit reference written here (32-bit limbs, long division), so the same
+/// checks run on the Cortex-M4 (tests/target) as on the host; where the compiler has __int128, the
+/// reference itself is checked against it on every input.
+#include <stdbool.h>
 #include <stdint.h>
 
 #include "odo/odo_fx.h"
@@ -23,28 +25,138 @@ static uint64_t spread_u64(void)
     return bits == 64U ? v : (v & ((1ULL << bits) - 1U)) | (1ULL << (bits - 1U));
 }
 
+/// Reference 128-bit unsigned integer: the test's own arithmetic, independent of odo_fx.c.
+typedef struct {
+    uint64_t hi;
+    uint64_t lo;
+} ref_u128_t;
+
+#define REF_M32 0xFFFFFFFFULL
+
+/// Schoolbook product of 32-bit limbs; every partial sum fits in 64 bits.
+static ref_u128_t ref_mul(uint64_t a, uint64_t b)
+{
+    const uint64_t a0 = a & REF_M32, a1 = a >> 32, b0 = b & REF_M32, b1 = b >> 32;
+    const uint64_t p00 = a0 * b0, p01 = a0 * b1, p10 = a1 * b0, p11 = a1 * b1;
+    const uint64_t mid = (p00 >> 32) + (p01 & REF_M32) + (p10 & REF_M32);
+    const ref_u128_t r = {p11 + (p01 >> 32) + (p10 >> 32) + (mid >> 32), (mid << 32) | (p00 & REF_M32)};
+    return r;
+}
+
+static ref_u128_t ref_add_u64(ref_u128_t a, uint64_t b)
+{
+    const ref_u128_t r = {a.hi + ((a.lo + b) < a.lo ? 1U : 0U), a.lo + b};
+    return r;
+}
+
+/// a >> n for 0 < n < 64.
+static ref_u128_t ref_shr_u128(ref_u128_t a, unsigned n)
+{
+    const ref_u128_t r = {a.hi >> n, (a.lo >> n) | (a.hi << (64U - n))};
+    return r;
+}
+
+/// Restoring long division, one bit per step: q = n / d, *rem = n % d (d != 0).
+static ref_u128_t ref_divmod(ref_u128_t n, uint64_t d, uint64_t *rem)
+{
+    ref_u128_t q = {0U, 0U};
+    uint64_t r = 0U;
+    for (int bit = 127; bit >= 0; --bit) {
+        const uint64_t in = bit >= 64 ? (n.hi >> (bit - 64)) & 1U : (n.lo >> bit) & 1U;
+        const bool carry = (r >> 63) != 0U; /* the shifted remainder has 65 bits */
+        r = (r << 1) | in;
+        if (carry || r >= d) {
+            r -= d;
+            if (bit >= 64) {
+                q.hi |= 1ULL << (bit - 64);
+            } else {
+                q.lo |= 1ULL << bit;
+            }
+        }
+    }
+    *rem = r;
+    return q;
+}
+
+#ifdef __SIZEOF_INT128__
+static void assert_ref_is(unsigned __int128 want, ref_u128_t got)
+{
+    TEST_ASSERT_EQUAL_HEX64((uint64_t)(want >> 64), got.hi);
+    TEST_ASSERT_EQUAL_HEX64((uint64_t)want, got.lo);
+}
+#endif
+
+/// The exact product by the reference, with the host's __int128 (where it has one) as a check of
+/// the reference.
+static ref_u128_t checked_mul(uint64_t a, uint64_t b)
+{
+    const ref_u128_t p = ref_mul(a, b);
+#ifdef __SIZEOF_INT128__
+    assert_ref_is((unsigned __int128)a * b, p);
+#endif
+    return p;
+}
+
+/// round(a b / 2^shift) with ties away from zero, for |b| < 2^32 (an int32 or a uint32 value) and
+/// any shift below 128. Returns true iff it fits int64; *out is the value, saturated when not.
+static bool ref_round_shift(int64_t a, int64_t b, unsigned shift, int64_t *out)
+{
+    const uint64_t ma = a < 0 ? 0U - (uint64_t)a : (uint64_t)a;
+    const uint64_t mb = b < 0 ? 0U - (uint64_t)b : (uint64_t)b;
+    const bool neg = (a < 0) != (b < 0);
+    ref_u128_t q = {0U, 0U};
+    if (shift < 120U) { /* |a b| < 2^95: larger shifts round to 0 */
+        ref_u128_t m = checked_mul(ma, mb);
+        if (shift > 0U) { /* + 2^(shift-1), then >> shift */
+            const unsigned h = shift - 1U;
+            const ref_u128_t half = {h >= 64U ? 1ULL << (h - 64U) : 0U, h < 64U ? 1ULL << h : 0U};
+            const uint64_t lo = m.lo + half.lo;
+            m.hi = m.hi + half.hi + (lo < m.lo ? 1U : 0U);
+            m.lo = lo;
+            if (shift >= 64U) {
+                m.lo = m.hi >> (shift - 64U);
+                m.hi = 0U;
+            } else {
+                m = ref_shr_u128(m, shift);
+            }
+        }
+        q = m;
+    }
+    const uint64_t limit = neg ? 1ULL << 63 : (uint64_t)INT64_MAX;
+    if (q.hi != 0U || q.lo > limit) {
+        *out = neg ? INT64_MIN : INT64_MAX;
+        return false;
+    }
+    *out = neg ? (int64_t)(0U - q.lo) : (int64_t)q.lo;
+    return true;
+}
+
+/// The saturated value of ref_round_shift.
+static int64_t ref_sat(int64_t a, int64_t b, unsigned shift)
+{
+    int64_t v = 0;
+    (void)ref_round_shift(a, b, shift, &v);
+    return v;
+}
+
 static void mul_u64_is_the_exact_128_bit_product(void)
 {
-#ifdef __SIZEOF_INT128__
     const uint64_t edge[] = {0U, 1U, 0xFFFFFFFFU, 0x100000000ULL, UINT64_MAX, UINT64_MAX - 1U};
     for (unsigned i = 0; i < 6; ++i) {
         for (unsigned j = 0; j < 6; ++j) {
-            const unsigned __int128 p = (unsigned __int128)edge[i] * edge[j];
+            const ref_u128_t p = checked_mul(edge[i], edge[j]);
             const odo_u128_t r = odo_mul_u64(edge[i], edge[j]);
-            TEST_ASSERT_EQUAL_HEX64((uint64_t)(p >> 64), r.hi);
-            TEST_ASSERT_EQUAL_HEX64((uint64_t)p, r.lo);
+            TEST_ASSERT_EQUAL_HEX64(p.hi, r.hi);
+            TEST_ASSERT_EQUAL_HEX64(p.lo, r.lo);
         }
     }
     for (int n = 0; n < 200000; ++n) {
         const uint64_t a = spread_u64(), b = spread_u64();
-        const unsigned __int128 p = (unsigned __int128)a * b;
+        const ref_u128_t p = checked_mul(a, b);
         const odo_u128_t r = odo_mul_u64(a, b);
-        TEST_ASSERT_EQUAL_HEX64((uint64_t)(p >> 64), r.hi);
-        TEST_ASSERT_EQUAL_HEX64((uint64_t)p, r.lo);
+        TEST_ASSERT_EQUAL_HEX64(p.hi, r.hi);
+        TEST_ASSERT_EQUAL_HEX64(p.lo, r.lo);
     }
-#else
-    TEST_IGNORE_MESSAGE("no 128-bit reference on this target");
-#endif
 }
 
 static void muldiv_rounds_to_nearest_and_reports_overflow(void)
@@ -61,19 +173,22 @@ static void muldiv_rounds_to_nearest_and_reports_overflow(void)
     TEST_ASSERT_FALSE(odo_muldiv_u64(UINT64_MAX, 2U, 1U, &q));  /* quotient >= 2^64 */
     TEST_ASSERT_FALSE(odo_muldiv_u64(UINT64_MAX, 3U, 2U, &q));  /* rounds up past 2^64 - 1 */
     TEST_ASSERT_EQUAL_UINT64(12345U, q);                        /* untouched on failure */
-#ifdef __SIZEOF_INT128__
     for (int n = 0; n < 100000; ++n) {
         const uint64_t a = spread_u64(), b = spread_u64(), d = spread_u64() | 1U;
+        uint64_t rem = 0U;
+        const ref_u128_t fl = ref_divmod(checked_mul(a, b), d, &rem);
+#ifdef __SIZEOF_INT128__
         const unsigned __int128 p = (unsigned __int128)a * b;
-        const unsigned __int128 fl = p / d, rem = p % d;
-        const unsigned __int128 want = fl + (rem >= d - rem ? 1U : 0U);
-        const bool fits = (want >> 64) == 0U;
+        assert_ref_is(p / d, fl);
+        TEST_ASSERT_EQUAL_HEX64((uint64_t)(p % d), rem);
+#endif
+        const ref_u128_t want = ref_add_u64(fl, rem >= d - rem ? 1U : 0U);
+        const bool fits = want.hi == 0U;
         TEST_ASSERT_EQUAL(fits, odo_muldiv_u64(a, b, d, &q));
         if (fits) {
-            TEST_ASSERT_EQUAL_HEX64((uint64_t)want, q);
+            TEST_ASSERT_EQUAL_HEX64(want.lo, q);
         }
     }
-#endif
 }
 
 static void mul_s64_s32_shr_is_exact_through_96_bits(void)
@@ -84,22 +199,30 @@ static void mul_s64_s32_shr_is_exact_through_96_bits(void)
     TEST_ASSERT_EQUAL_INT64(-3, odo_mul_s64_s32_shr(-5, 1, 1U));  /* -2.5 rounds away from zero */
     TEST_ASSERT_EQUAL_INT64(3, odo_mul_s64_s32_shr(5, 1, 1U));
     TEST_ASSERT_EQUAL_INT64(-2, odo_mul_s64_s32_shr(-9, 1, 2U));  /* -2.25 -> -2 */
-#ifdef __SIZEOF_INT128__
     const int64_t ea[] = {INT64_MIN, INT64_MIN + 1, -1, 0, 1, INT64_MAX};
     const int32_t eb[] = {INT32_MIN, -1, 0, 1, INT32_MAX, 1 << 30};
     for (int n = 0; n < 300000; ++n) {
         const int64_t a = n < 36 ? ea[n / 6] : (int64_t)spread_u64();
         const int32_t b = n < 36 ? eb[n % 6] : (int32_t)(uint32_t)ts_rng_u64(&rng);
         const unsigned shift = 30U + (unsigned)(ts_rng_u64(&rng) % 33U); /* 30..62 */
+        /* |a b| rounded half away from zero, then the sign: the magnitude is below 2^95. */
+        const uint64_t ma = a < 0 ? 0U - (uint64_t)a : (uint64_t)a;
+        const uint64_t mb = b < 0 ? 0U - (uint64_t)(int64_t)b : (uint64_t)b;
+        const bool neg = (a < 0) != (b < 0);
+        const ref_u128_t mag = ref_shr_u128(ref_add_u64(checked_mul(ma, mb), 1ULL << (shift - 1U)), shift);
+#ifdef __SIZEOF_INT128__
         const __int128 p = (__int128)a * b;
         const __int128 half = (__int128)1 << (shift - 1U);
-        const __int128 want = p >= 0 ? (p + half) >> shift : -((-p + half) >> shift);
-        if (want > INT64_MAX || want < INT64_MIN) {
+        const __int128 w128 = p >= 0 ? (p + half) >> shift : -((-p + half) >> shift);
+        assert_ref_is((unsigned __int128)(w128 >= 0 ? w128 : -w128), mag);
+#endif
+        const uint64_t limit = neg ? 1ULL << 63 : (uint64_t)INT64_MAX;
+        if (mag.hi != 0U || mag.lo > limit) {
             continue; /* outside the documented domain */
         }
-        TEST_ASSERT_EQUAL_INT64((int64_t)want, odo_mul_s64_s32_shr(a, b, shift));
+        const int64_t want = neg ? (int64_t)(0U - mag.lo) : (int64_t)mag.lo;
+        TEST_ASSERT_EQUAL_INT64(want, odo_mul_s64_s32_shr(a, b, shift));
     }
-#endif
 }
 
 static void mul_s64_u32_shr_is_exact_through_96_bits(void)
@@ -108,22 +231,28 @@ static void mul_s64_u32_shr_is_exact_through_96_bits(void)
     TEST_ASSERT_EQUAL_INT64(-3, odo_mul_s64_u32_shr(-5, 1U, 1U)); /* -2.5 rounds away from zero */
     TEST_ASSERT_EQUAL_INT64(3, odo_mul_s64_u32_shr(5, 1U, 1U));
     TEST_ASSERT_EQUAL_INT64(INT64_MAX / 2 + 1, odo_mul_s64_u32_shr(INT64_MAX, 0x80000000U, 32U)); /* 2^62 - 0.5 */
-#ifdef __SIZEOF_INT128__
     const int64_t ea[] = {INT64_MIN, INT64_MIN + 1, -1, 0, 1, INT64_MAX};
     const uint32_t eb[] = {0U, 1U, 0x7FFFFFFFU, 0x80000000U, 0xFFFFFFFEU, UINT32_MAX};
     for (int n = 0; n < 300000; ++n) {
         const int64_t a = n < 36 ? ea[n / 6] : (int64_t)spread_u64();
         const uint32_t b = n < 36 ? eb[n % 6] : (uint32_t)ts_rng_u64(&rng);
         const unsigned shift = 1U + (unsigned)(ts_rng_u64(&rng) % 62U); /* 1..62 */
+        int64_t want = 0;
+        const bool fits = ref_round_shift(a, (int64_t)b, shift, &want);
+#ifdef __SIZEOF_INT128__
         const __int128 p = (__int128)a * b;
         const __int128 half = (__int128)1 << (shift - 1U);
-        const __int128 want = p >= 0 ? (p + half) >> shift : -((-p + half) >> shift);
-        if (want > INT64_MAX || want < INT64_MIN) {
+        const __int128 w128 = p >= 0 ? (p + half) >> shift : -((-p + half) >> shift);
+        TEST_ASSERT_EQUAL(w128 <= INT64_MAX && w128 >= INT64_MIN, fits);
+        if (fits) {
+            TEST_ASSERT_EQUAL_INT64((int64_t)w128, want);
+        }
+#endif
+        if (!fits) {
             continue; /* outside the documented domain */
         }
-        TEST_ASSERT_EQUAL_INT64((int64_t)want, odo_mul_s64_u32_shr(a, b, shift));
+        TEST_ASSERT_EQUAL_INT64(want, odo_mul_s64_u32_shr(a, b, shift));
     }
-#endif
 }
 
 /// round(n 2^32 / d), computed here with a 64-bit division the firmware does not use.
@@ -180,7 +309,8 @@ static void shr_round_is_symmetric_and_safe_at_the_extremes(void)
 }
 
 #ifdef __SIZEOF_INT128__
-/// round(p / 2^shift) ties away from zero, saturated to int64: the contract of both functions.
+/// round(p / 2^shift) ties away from zero, saturated to int64: the contract of both functions, in
+/// the host's __int128, as a check of the portable ref_round_shift.
 static int64_t ref_shr(__int128 p, unsigned shift)
 {
     __int128 q;
@@ -223,30 +353,35 @@ static void shifts_are_defined_for_every_shift_and_saturate(void)
     TEST_ASSERT_EQUAL_INT64(0, odo_shr_round_s64(INT64_MAX, 64U));
     TEST_ASSERT_EQUAL_INT64(0, odo_shr_round_s64(INT64_MIN, 65U));
     TEST_ASSERT_EQUAL_INT64(0, odo_shr_round_s64(INT64_MIN, UINT32_MAX));
-#ifdef __SIZEOF_INT128__
     const int64_t ea[] = {0, 1, -1, 3, -3, INT64_MAX, INT64_MIN, INT64_MAX - 1, INT64_MIN + 1,
                           (int64_t)1 << 62, -((int64_t)1 << 62)};
     const int32_t eb[] = {0, 1, -1, 2, -2, INT32_MAX, INT32_MIN, 1 << 30, -(1 << 30)};
     for (unsigned shift = 0U; shift < 128U; ++shift) {
         for (unsigned i = 0U; i < sizeof ea / sizeof ea[0]; ++i) {
-            TEST_ASSERT_EQUAL_INT64(ref_shr(ea[i], shift), odo_shr_round_s64(ea[i], shift));
+            TEST_ASSERT_EQUAL_INT64(ref_sat(ea[i], 1, shift), odo_shr_round_s64(ea[i], shift));
             for (unsigned j = 0U; j < sizeof eb / sizeof eb[0]; ++j) {
-                const __int128 p = (__int128)ea[i] * eb[j];
-                TEST_ASSERT_EQUAL_INT64(ref_shr(p, shift), odo_mul_s64_s32_shr(ea[i], eb[j], shift));
+                TEST_ASSERT_EQUAL_INT64(ref_sat(ea[i], eb[j], shift), odo_mul_s64_s32_shr(ea[i], eb[j], shift));
                 const uint32_t ub = (uint32_t)eb[j];
-                TEST_ASSERT_EQUAL_INT64(ref_shr((__int128)ea[i] * ub, shift), odo_mul_s64_u32_shr(ea[i], ub, shift));
+                TEST_ASSERT_EQUAL_INT64(ref_sat(ea[i], (int64_t)ub, shift), odo_mul_s64_u32_shr(ea[i], ub, shift));
+#ifdef __SIZEOF_INT128__
+                TEST_ASSERT_EQUAL_INT64(ref_shr((__int128)ea[i] * eb[j], shift), ref_sat(ea[i], eb[j], shift));
+                TEST_ASSERT_EQUAL_INT64(ref_shr((__int128)ea[i] * ub, shift), ref_sat(ea[i], (int64_t)ub, shift));
+#endif
             }
         }
         for (int n = 0; n < 2000; ++n) {
             const int64_t a = (int64_t)spread_u64();
             const uint32_t u = (uint32_t)spread_u64();
             const int32_t b = (int32_t)u;
-            TEST_ASSERT_EQUAL_INT64(ref_shr(a, shift), odo_shr_round_s64(a, shift));
-            TEST_ASSERT_EQUAL_INT64(ref_shr((__int128)a * b, shift), odo_mul_s64_s32_shr(a, b, shift));
-            TEST_ASSERT_EQUAL_INT64(ref_shr((__int128)a * u, shift), odo_mul_s64_u32_shr(a, u, shift));
+            TEST_ASSERT_EQUAL_INT64(ref_sat(a, 1, shift), odo_shr_round_s64(a, shift));
+            TEST_ASSERT_EQUAL_INT64(ref_sat(a, b, shift), odo_mul_s64_s32_shr(a, b, shift));
+            TEST_ASSERT_EQUAL_INT64(ref_sat(a, (int64_t)u, shift), odo_mul_s64_u32_shr(a, u, shift));
+#ifdef __SIZEOF_INT128__
+            TEST_ASSERT_EQUAL_INT64(ref_shr((__int128)a * b, shift), ref_sat(a, b, shift));
+            TEST_ASSERT_EQUAL_INT64(ref_shr((__int128)a * u, shift), ref_sat(a, (int64_t)u, shift));
+#endif
         }
     }
-#endif
 }
 
 int main(void)

@@ -148,16 +148,51 @@ static void test_sin_squared_plus_cos_squared_is_one(void)
     TEST_ASSERT_LESS_OR_EQUAL_DOUBLE(2.83 * SINCOS_BOUND, worst);
 }
 
+/// (cos, sin) of k pi/16 for k = 0..7 in Q30, as integers: the atan2 inputs below are built from
+/// these and integer arithmetic only, so they are bit-identical on every platform (libm's sin/cos
+/// differ in the last bit between glibc and newlib, and tests/target compares host and Cortex-M4
+/// output byte for byte).
+static const int64_t k_dir_q30[8][2] = {
+    {1073741824, 0},         {1053110176, 209476638}, {992008094, 410903207},
+    {892783698, 596538995},  {759250125, 759250125}, {596538995, 892783698},
+    {410903207, 992008094},  {209476638, 1053110176},
+};
+
+/// round(p * 2^(e - 50)) with the rounding half away from zero, for |p| < 2^51 and 0 <= e <= 62.
+static int64_t scale_pow2(int64_t p, int e)
+{
+    const uint64_t mag = p < 0 ? (uint64_t)(-p) : (uint64_t)p;
+    const uint64_t r = e >= 50 ? mag << (e - 50) : (mag + (1ULL << (49 - e))) >> (50 - e);
+    return p < 0 ? -(int64_t)r : (int64_t)r;
+}
+
 /// One random vector for atan2. Three shapes in turn, so that every octant, every scale from 1
 /// to 2^62, near-axis directions and the raw int64 range (INT64_MIN included) are all sampled.
 static void random_vector(ts_rng_t *rng, unsigned long i, int64_t *y, int64_t *x)
 {
     switch (i % 3U) {
-    case 0: { // polar: uniform direction, magnitude 2^e * [1, 2), e in [0, 62]
-        const double th = ts_rng_uniform(rng, 0.0, TWO_PI);
-        const double r = ldexp(ts_rng_uniform(rng, 1.0, 1.99), (int)ts_rng_range(rng, 0, 62));
-        *x = (int64_t)llround(r * cos(th));
-        *y = (int64_t)llround(r * sin(th));
+    case 0: { // polar: any direction, magnitude 2^e * [1, 1.99), e in [0, 62]
+        /* One of 32 fixed directions k pi/16 (a table entry turned by k/8 quarter turns), turned
+         * by a random d in [-pi/32, pi/32] with cos d ~ 1 - d^2/2, sin d ~ d - d^3/6 (Q30): the
+         * direction only has to be spread evenly, not exact; |(c, s)| = 1 within 1e-5. */
+        const int64_t k = ts_rng_range(rng, 0, 31);
+        int64_t c = k_dir_q30[k % 8][0];
+        int64_t s = k_dir_q30[k % 8][1];
+        for (int64_t q = 0; q < k / 8; ++q) {
+            const int64_t t = c;
+            c = -s;
+            s = t;
+        }
+        const int64_t d = ts_rng_range(rng, -105414357, 105414357); // pi/32 in Q30
+        const int64_t d2 = d * d / ODO_Q30_ONE;
+        const int64_t cd = ODO_Q30_ONE - d2 / 2;
+        const int64_t sd = d - d2 * d / ODO_Q30_ONE / 6;
+        const int64_t cx = (c * cd - s * sd) / ODO_Q30_ONE;
+        const int64_t sy = (s * cd + c * sd) / ODO_Q30_ONE;
+        const int64_t m_q20 = ts_rng_range(rng, 1 << 20, 2086666); // [1, 1.99) in Q20
+        const int e = (int)ts_rng_range(rng, 0, 62);
+        *x = scale_pow2(cx * m_q20, e);
+        *y = scale_pow2(sy * m_q20, e);
         break;
     }
     case 1: { // independent magnitudes 2^e..2^(e+1)-1, e in [0, 62]: steep and flat vectors

@@ -17,6 +17,7 @@
 
 #include "acceptance.h"
 #include "calib_core.h"
+#include "fit_cli.h"
 #include "image.h"
 #include "params_diag.h"
 #include "params_json.h"
@@ -44,8 +45,11 @@ static void usage(FILE *f)
             "      .odo_params); CRC recomputed; in place unless --out.\n"
             "  read --image FW [--json]     print the image's parameter block (version 1 or 2)\n"
             "  verify --image FW            check the image's block (layout, version, CRC, ranges)\n"
-            "  export --params P.json|P.bin --format ros2\n"
-            "      diff_drive_controller multipliers (YAML) for ros2_controllers\n"
+            "  export --params P.json|P.bin --format ros2 [--controller-name NAME]\n"
+            "      diff_drive_controller parameters (YAML): absolute values and multipliers\n"
+            "  fit --runs DIR... --robot R.json [--fit GLOB...] [--judge GLOB...] [--out-params P]... [--json]\n"
+            "      calibrate Ed, Eb, Es and the turn-radius-dependent wheelbase from runs on any path\n"
+            "      with a truth track or return poses (odo-import folders); held-out before/after.\n"
             "  acceptance [--robots N] [--seed S] [--runs N] [--json] [--no-tape] [--quiet]\n"
             "      simulated labmates (Ed ~ U[0.995, 1.005], b ~ U[0.97, 1.03] x 340 mm, floor\n"
             "      roughness): Emax,syst before/after one pass, exact and paper methods; E-7/E-8\n"
@@ -141,7 +145,7 @@ static int write_atomic(const char *path, const void *data, size_t len)
 }
 
 /// Parameters as JSON text (malloc'd) or as the 128-byte block, by the output's extension.
-static int write_params(const char *path, const odo_params_t *p)
+int calib_write_params(const char *path, const odo_params_t *p)
 {
     if (ends_with(path, ".bin")) {
         uint8_t block[ODO_PARAMS_SIZE];
@@ -318,7 +322,7 @@ static int cmd_umbmark(int argc, char **argv)
     if (out != NULL) {
         odo_params_t np;
         calib_apply(&in_force, &c, &np);
-        if (write_params(out, &np) != 0) {
+        if (calib_write_params(out, &np) != 0) {
             return EXIT_FAIL;
         }
     }
@@ -519,26 +523,41 @@ static int cmd_verify(int argc, char **argv)
 static int cmd_export(int argc, char **argv)
 {
     if (help_if(argc, argv,
-                "usage: odo-calib export --params P.json|P.bin --format ros2\n"
+                "usage: odo-calib export --params P.json|P.bin --format ros2 [--controller-name NAME]\n"
                 "\n"
                 "Print truck A's calibration as a ros2_controllers diff_drive_controller parameter\n"
-                "fragment (YAML): wheel_separation_multiplier = Eb (000 Eq. 6.28),\n"
-                "left/right_wheel_radius_multiplier = cL/Es, cR/Es (Eqs. 6.33-6.35, App. B). Put it under\n"
-                "your controller's name in the controller manager's parameter file.\n")) {
+                "file (YAML) under NAME (default diff_drive_controller: the name your controller has in\n"
+                "the controller manager). Absolute values and multipliers both: wheel_separation = b\n"
+                "(nominal) with wheel_separation_multiplier = Eb (000 Eq. 6.28), wheel_radius = Dn/2\n"
+                "with left/right_wheel_radius_multiplier = cL/Es, cR/Es (Eqs. 6.33-6.35, App. B);\n"
+                "diff_drive_controller multiplies them. The model's turn-radius-dependent wheelbase\n"
+                "(scrub, odo-calib fit) has no diff_drive_controller parameter: it is printed as a\n"
+                "comment with the effective separation it implies on arcs (tools/calib/README.md).\n")) {
         return 0;
     }
-    opt_t o[] = {{"--params", 1, NULL}, {"--format", 1, NULL}};
-    const size_t n = 2;
+    opt_t o[] = {{"--params", 1, NULL}, {"--format", 1, NULL}, {"--controller-name", 1, NULL}};
+    const size_t n = 3;
     if (parse_opts("export", argc, argv, o, n) != 0) {
         return EXIT_USAGE;
     }
     const char *params = opt(o, n, "--params"), *format = opt(o, n, "--format");
+    const char *name = opt(o, n, "--controller-name") != NULL ? opt(o, n, "--controller-name") : "diff_drive_controller";
     if (params == NULL || format == NULL) {
         fprintf(stderr, "%s export: --params and --format are required\n", k_prog);
         return EXIT_USAGE;
     }
     if (strcmp(format, "ros2") != 0) {
         fprintf(stderr, "%s export: unknown format '%s' (ros2)\n", k_prog, format);
+        return EXIT_USAGE;
+    }
+    /* A ROS 2 node name: letters, digits and underscores, not starting with a digit. */
+    int name_ok = name[0] != '\0' && !(name[0] >= '0' && name[0] <= '9');
+    for (const char *c = name; *c != '\0' && name_ok; ++c) {
+        name_ok = (*c >= 'a' && *c <= 'z') || (*c >= 'A' && *c <= 'Z') || (*c >= '0' && *c <= '9') || *c == '_';
+    }
+    if (!name_ok) {
+        fprintf(stderr, "%s export: --controller-name '%s' is not a ROS 2 node name ([A-Za-z_][A-Za-z0-9_]*)\n",
+                k_prog, name);
         return EXIT_USAGE;
     }
     odo_params_t p;
@@ -550,18 +569,23 @@ static int cmd_export(int argc, char **argv)
     const odo_truck_params_t *t = &p.truck[0];
     int32_t cl = 0, cr = 0;
     (void)odo_umb_correction_factors(t->ed_q30, &cl, &cr);
-    const double es = t->es_q30 / Q30;
+    const double es = t->es_q30 / Q30, eb = t->eb_q30 / Q30, scrub = t->scrub_q30 / Q30;
     printf("# odo-calib export --format ros2, from %s (truck A)\n"
-           "# diff_drive_controller: wheel_separation = wheel_separation_multiplier * wheel_separation,\n"
-           "# wheel radius = *_wheel_radius_multiplier * wheel_radius. Nominal: wheel_separation %.6f m,\n"
-           "# wheel_radius %.6f m. Ed %.9f, Eb %.9f, Es %.9f.\n"
-           "diff_drive_controller:\n"
+           "# diff_drive_controller uses wheel_separation * wheel_separation_multiplier and\n"
+           "# wheel_radius * <side>_wheel_radius_multiplier. Ed %.9f, Eb %.9f, Es %.9f.\n"
+           "# Effective: wheel_separation %.6f m, left radius %.6f m, right radius %.6f m.\n"
+           "# scrub (turn-radius-dependent wheelbase) %.6f: not a diff_drive_controller parameter; the\n"
+           "# separation above is the spot-turn one; on an arc of radius R it is b Eb / (1 - scrub (1 - b/(2R))).\n"
+           "%s:\n"
            "  ros__parameters:\n"
+           "    wheel_separation: %.6f\n"
+           "    wheel_radius: %.6f\n"
            "    wheel_separation_multiplier: %.9f\n"
            "    left_wheel_radius_multiplier: %.9f\n"
            "    right_wheel_radius_multiplier: %.9f\n",
-           params, t->wheelbase_nm / 1e9, t->wheel_diameter_nm / 2e9, t->ed_q30 / Q30, t->eb_q30 / Q30, es,
-           t->eb_q30 / Q30, cl / Q30 / es, cr / Q30 / es);
+           params, t->ed_q30 / Q30, eb, es, t->wheelbase_nm / 1e9 * eb, t->wheel_diameter_nm / 2e9 * cl / Q30 / es,
+           t->wheel_diameter_nm / 2e9 * cr / Q30 / es, scrub, name, t->wheelbase_nm / 1e9, t->wheel_diameter_nm / 2e9,
+           eb, cl / Q30 / es, cr / Q30 / es);
     return 0;
 }
 
@@ -586,6 +610,9 @@ int main(int argc, char **argv)
     }
     if (strcmp(cmd, "export") == 0) {
         return cmd_export(argc - 2, argv + 2);
+    }
+    if (strcmp(cmd, "fit") == 0) {
+        return calib_fit_main(argc - 2, argv + 2);
     }
     if (strcmp(cmd, "acceptance") == 0) {
         return calib_acceptance_main(argc - 2, argv + 2);

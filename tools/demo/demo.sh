@@ -7,6 +7,11 @@ cd "$(dirname "$0")/../.."
 BIN=build/host/bin
 OUT=${ODO_DEMO_OUT:-out/demo}
 mkdir -p "$OUT"
+
+# The main job: a real robot's recorded runs, import -> calibrate -> write -> replay (issue 14).
+bash tools/demo/realdata_demo.sh "$OUT/real"
+echo
+echo "Simulated robot:"
 for dir in cw ccw; do
   "$BIN/odo-demo" --direction "$dir" --out "$OUT/$dir"
 done

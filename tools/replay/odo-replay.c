@@ -214,6 +214,7 @@ static int write_summary(FILE *f, const char *mode, const char *input, const rep
     if (ls != NULL) {
         bad |= set_u64(o, "log_lines", ls->lines);
         bad |= set_u64(o, "log_blank", ls->blank);
+        bad |= set_u64(o, "log_can_fd_skipped", ls->fd_skipped);
     }
     if (ss != NULL) {
         json_t *b = json_object();
@@ -504,6 +505,10 @@ int main(int argc, char **argv)
         fprintf(stderr, "odo-replay: warning: %" PRIu64 " gap(s) longer than %u ticks skipped, %.6g s in all "
                         "(longest %.6g s)\n", r.stats.gaps, REPLAY_MAX_GAP_TICKS, (double)r.stats.gap_us / 1e6,
                 (double)r.stats.longest_gap_us / 1e6);
+    }
+    if (log != NULL && reader.stats.fd_skipped > 0U && !quiet) {
+        fprintf(stderr, "odo-replay: %" PRIu64 " CAN FD lines (another node's traffic) skipped\n",
+                reader.stats.fd_skipped);
     }
     if (r.stats.ignored > 0U && !quiet) {
         fprintf(stderr, "odo-replay: %" PRIu64 " frames not consumed (unknown ID, RTR, extended or output "

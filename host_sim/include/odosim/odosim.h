@@ -130,6 +130,29 @@ size_t odosim_sizeof(const char *type_name);
 
 void odosim_free(void *p);
 
+/* ---------------------------------------------------------------------------------------------
+ * The robot-description contract and the firmware's step, for tools that must not re-implement
+ * either (host_sim/run/odosim_robot.c).
+ * ------------------------------------------------------------------------------------------- */
+
+/// Parse and validate a robot description with THE validator (host_sim/src/robot.c's limits table
+/// and odo_params_validate) and return what it means as compact JSON (malloc'd; odosim_free):
+/// {"vehicle", "tick_ms", "heading_form", "max_wheel_speed_mm_s", "trucks": [{"wheel_diameter_mm",
+/// "wheelbase_mm", "encoder_lines", "gear_ratio", "counter_bits", "invert_left", "invert_right",
+/// "ed", "eb", "es"}, ...], "linkage" (clapper) / "trailer" (set)}. NULL with "<path>: <field>:
+/// <why>" in err on any error.
+char *odosim_robot_describe(const char *robot_path, char *err, size_t errlen);
+
+/// The limits table as JSON [{"key", "lo", "hi", "unit"}, ...] (malloc'd; odosim_free), or NULL.
+char *odosim_robot_limits_json(void);
+
+/// Run the firmware's application step (odo_app_step, booted on the robot's block) over raw
+/// counter readings of truck A, raw[2 i] left, raw[2 i + 1] right (as the decoder holds them, low
+/// counter_bits bits), one per tick; pose[3 i .. 3 i + 2] receives x_mm, y_mm and the heading in
+/// rad (unwrapped). Tick 0 sets the counter baseline. Returns 0, or -1 with a message.
+int odosim_firmware_track(const char *robot_path, const uint32_t *raw, size_t n, double *pose, char *err,
+                          size_t errlen);
+
 #ifdef __cplusplus
 }
 #endif

@@ -104,6 +104,7 @@ class Robot:
     linkage: dict = field(default_factory=dict)
     trailer: dict = field(default_factory=dict)
     raw: dict = field(default_factory=dict)
+    described: dict = field(default_factory=dict)  # odosim_robot_describe: what the C parser read
 
     def mm_per_count(self, t: int) -> float:
         d = self.trucks[t]
@@ -114,76 +115,60 @@ class Robot:
         return len(self.trucks)
 
 
-def _num(obj: dict, key: str, where: str, path: Path, lo: float, hi: float) -> float:
-    v = obj.get(key)
-    if not isinstance(v, (int, float)) or isinstance(v, bool) or not (lo <= v <= hi):
-        raise GapInputError(path, f"{where}{key}: expected a number in [{lo}, {hi}], got {v!r}")
-    return float(v)
-
-
 def read_robot(path: str | Path) -> Robot:
-    """A robot description (host_sim/robots/*.json schema): what the firmware believes."""
+    """A robot description (host_sim/robots/*.json schema): what the firmware believes.
+
+    Parsed and validated by THE validator, host_sim/src/robot.c (its limits table and the
+    firmware's odo_params_validate), through libodosim: Python keeps no limits of its own.
+    """
+    import ctypes as C
+
+    from .simlib import lib
+
     path = Path(path)
+    so = lib()
+    fn = so.odosim_robot_describe
+    fn.restype = C.c_void_p
+    fn.argtypes = [C.c_char_p, C.c_char_p, C.c_size_t]
+    err = C.create_string_buffer(1024)
+    ptr = fn(str(path).encode(), err, len(err))
+    if not ptr:
+        why = err.value.decode(errors="replace")
+        # the C message is "<path>: <field>: <why>"; GapInputError adds the path again
+        prefix = f"{path}: "
+        raise GapInputError(path, why[len(prefix) :] if why.startswith(prefix) else why)
     try:
-        text = path.read_text()
-    except OSError as e:
-        raise GapInputError(path, f"cannot read robot description: {e.strerror}") from None
-    try:
-        raw = json.loads(text)
-    except json.JSONDecodeError as e:
-        raise GapInputError(path, f"malformed JSON: {e.msg} (column {e.colno})", e.lineno) from None
-    if not isinstance(raw, dict) or raw.get("vehicle") not in ("labmate", "clapper", "set"):
-        raise GapInputError(path, "vehicle: expected labmate, clapper or set")
-    trucks_raw = raw.get("trucks")
-    names = ["A"] if raw["vehicle"] == "labmate" else ["A", "B"]
-    if not isinstance(trucks_raw, dict) or any(n not in trucks_raw for n in names):
-        raise GapInputError(path, f"trucks: expected {' and '.join(names)}")
-    trucks = []
-    for n in names:
-        t = trucks_raw[n]
-        w = f"trucks.{n}."
-        trucks.append(
-            {
-                "wheel_diameter_mm": _num(t, "wheel_diameter_mm", w, path, 1.0, 5000.0),
-                "wheelbase_mm": _num(t, "wheelbase_mm", w, path, 1.0, 10000.0),
-                "encoder_lines": _num(t, "encoder_lines", w, path, 1.0, 1e7),
-                "gear_ratio": _num(t, "gear_ratio", w, path, 1e-3, 1e4),
-                "counter_bits": int(_num(t, "counter_bits", w, path, 8, 32)),
-                "invert_left": bool(t.get("invert_left", False)),
-                "invert_right": bool(t.get("invert_right", False)),
-            }
-        )
-    tick_ms = _num(raw, "tick_ms", "", path, 1.0, 1000.0) if "tick_ms" in raw else 40.0
-    r = Robot(str(path), raw["vehicle"], tick_ms / 1000.0, trucks, raw=raw)
-    if r.vehicle == "clapper":
-        lk = raw.get("linkage")
-        if not isinstance(lk, dict):
-            raise GapInputError(path, "linkage: required for a clapper")
-        r.linkage = {
-            "length_mm": _num(lk, "length_mm", "linkage.", path, 1.0, 1e5),
-            "rotary_bits": int(lk.get("rotary_bits", 10)),
-            "linear_resolution_mm": float(lk.get("linear_resolution_mm", 0.1)),
+        doc = json.loads(C.string_at(ptr).decode())
+    finally:
+        so.odosim_free(ptr)
+    raw = json.loads(path.read_text())
+    trucks = [
+        {
+            "wheel_diameter_mm": t["wheel_diameter_mm"],
+            "wheelbase_mm": t["wheelbase_mm"],
+            "encoder_lines": t["encoder_lines"],
+            "gear_ratio": t["gear_ratio"],
+            "counter_bits": int(t["counter_bits"]),
+            "invert_left": bool(t["invert_left"]),
+            "invert_right": bool(t["invert_right"]),
         }
-        rg = lk.get("range_mm")  # mechanical range of l (robot.c default: length +- 100 mm)
-        L = r.linkage["length_mm"]
-        if rg is None:
-            rg = [L - 100.0, L + 100.0]
-        if (
-            not isinstance(rg, list)
-            or len(rg) != 2
-            or not all(isinstance(v, (int, float)) for v in rg)
-            or not rg[0] < L < rg[1]
-        ):
-            raise GapInputError(path, "linkage.range_mm: expected [min, max] around length_mm")
-        r.linkage["range_mm"] = (float(rg[0]), float(rg[1]))
-    if r.vehicle == "set":
-        tr = raw.get("trailer")
-        if not isinstance(tr, dict):
-            raise GapInputError(path, "trailer: required for a set")
+        for t in doc["trucks"]
+    ]
+    r = Robot(str(path), doc["vehicle"], doc["tick_ms"] / 1000.0, trucks, raw=raw, described=doc)
+    if "linkage" in doc:
+        lk = doc["linkage"]
+        r.linkage = {
+            "length_mm": lk["length_mm"],
+            "rotary_bits": int(lk["rotary_bits"]),
+            "linear_resolution_mm": lk["linear_resolution_mm"],
+            "range_mm": (float(lk["range_mm"][0]), float(lk["range_mm"][1])),
+        }
+    if "trailer" in doc:
+        tr = doc["trailer"]
         r.trailer = {
-            "hitch_offset_mm": _num(tr, "hitch_offset_mm", "trailer.", path, 0.0, 1e5),
-            "trailer_length_mm": _num(tr, "trailer_length_mm", "trailer.", path, 1.0, 1e5),
-            "rotary_bits": int(tr.get("rotary_bits", 10)),
+            "hitch_offset_mm": tr["hitch_offset_mm"],
+            "trailer_length_mm": tr["trailer_length_mm"],
+            "rotary_bits": int(tr["rotary_bits"]),
         }
     return r
 
@@ -198,30 +183,51 @@ class SensorLog:
     alpha_deg: np.ndarray | None = None  # (n,) linkage rotary A (clapper) / joint (set)
     beta_deg: np.ndarray | None = None
     l_mm: np.ndarray | None = None
+    fd_skipped: int = 0  # CAN FD lines counted and skipped
 
 
 def read_log(path: str | Path, robot: Robot) -> SensorLog:
-    """Decode a candump -l log of sensor frames with the DBC; checks it against the robot."""
+    """Decode a candump -l log of sensor frames with the DBC; checks it against the robot.
+
+    Lines are read by python-can's CanutilsLogReader (so python-can's trailing " R"/" T" and
+    every form candump writes are accepted); CAN FD frames (another node's traffic on a mixed bus)
+    are counted in SensorLog.fd_skipped and skipped, as the C reader does.
+    """
+    import can
+
     path = Path(path)
     try:
         lines = path.read_text().splitlines()
     except (OSError, UnicodeDecodeError) as e:
         raise GapInputError(path, f"cannot read log: {getattr(e, 'strerror', None) or e}") from None
-    if not lines:
+    content = [i + 1 for i, ln in enumerate(lines) if ln.strip()]
+    if not content:
         raise GapInputError(path, "empty log: no sensor frames")
-    ts = np.empty(len(lines))
-    ids = np.empty(len(lines), dtype=np.int64)
-    pay = np.zeros(len(lines), dtype=np.uint64)
-    for i, ln in enumerate(lines):
-        m = LINE_RE.match(ln.strip())
-        if m is None:
-            raise GapInputError(path, f"not a candump -l line: {ln[:60]!r}", i + 1)
-        data = m.group(4)
-        if len(data) % 2 or len(data) > 16:
-            raise GapInputError(path, f"bad payload {data!r}", i + 1)
-        ts[i] = float(m.group(1))
-        ids[i] = int(m.group(3), 16)
-        pay[i] = int.from_bytes(bytes.fromhex(data).ljust(8, b"\0"), "little")
+    ts_l: list[float] = []
+    ids_l: list[int] = []
+    pay_l: list[int] = []
+    fd = 0
+    done = 0  # lines python-can has parsed
+    try:
+        for m in can.CanutilsLogReader(str(path)):
+            done += 1
+            if m.is_fd:
+                fd += 1
+                continue
+            if m.is_error_frame or m.is_remote_frame:
+                continue
+            ts_l.append(m.timestamp)
+            ids_l.append(m.arbitration_id | (0x80000000 if m.is_extended_id else 0))
+            pay_l.append(int.from_bytes(bytes(m.data).ljust(8, b"\0")[:8], "little"))
+    except Exception as e:  # python-can raises ValueError/IndexError on a malformed line
+        line = content[min(done, len(content) - 1)]
+        bad = lines[line - 1][:60]
+        raise GapInputError(path, f"not a candump -l line: {bad!r} ({e})", line) from None
+    if not ts_l:
+        raise GapInputError(path, "no classic CAN frames (only CAN FD, error or remote frames)")
+    ts = np.asarray(ts_l)
+    ids = np.asarray(ids_l, dtype=np.int64)
+    pay = np.asarray(pay_l, dtype=np.uint64)
     bad = np.nonzero(np.diff(ts) < 0)[0]
     if bad.size:
         raise GapInputError(path, "time goes backwards", int(bad[0]) + 2)
@@ -281,7 +287,7 @@ def read_log(path: str | Path, robot: Robot) -> SensorLog:
                     int(np.nonzero(sel)[0][np.argmax(v >= (1 << bits))]) + 1,
                 )
             counts[:, tr, w] = _fill(v, idx, n)
-    log = SensorLog(str(path), t, counts)
+    log = SensorLog(str(path), t, counts, fd_skipped=fd)
     sel_r, sel_l = ids == ID_ROTARY, ids == ID_LINEAR
     if sel_r.any():
         idx = _align(path, ts[sel_r], t, np.nonzero(sel_r)[0])
