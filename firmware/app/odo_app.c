@@ -148,10 +148,9 @@ static void publish(const odo_app_t *app, uint8_t pose_flags[ODO_TRUCKS], odo_ti
         odo_can_pack_ipec_corr(&corr, &out->frames[n++]);
     }
     /* Rejected frames since boot, this tick's included (counted after publishing). */
-    const uint64_t rejected = (uint64_t)app->faults.count[FAULT_BIT_CAN_BAD_DLC] +
-                              app->faults.count[FAULT_BIT_CAN_UNKNOWN_ID] +
-                              ((out->faults >> FAULT_BIT_CAN_BAD_DLC) & 1U) +
-                              ((out->faults >> FAULT_BIT_CAN_UNKNOWN_ID) & 1U);
+    const uint64_t rejected =
+        (uint64_t)app->faults.count[FAULT_BIT_CAN_BAD_DLC] + app->faults.count[FAULT_BIT_CAN_UNKNOWN_ID] +
+        ((out->faults >> FAULT_BIT_CAN_BAD_DLC) & 1U) + ((out->faults >> FAULT_BIT_CAN_UNKNOWN_ID) & 1U);
     const odo_msg_status_t st = {out->faults, app->out_seq, (uint8_t)app->params_status,
                                  (uint16_t)(rejected > UINT16_MAX ? UINT16_MAX : rejected)};
     odo_can_pack_status(&st, &out->frames[n++]);
@@ -159,8 +158,8 @@ static void publish(const odo_app_t *app, uint8_t pose_flags[ODO_TRUCKS], odo_ti
 }
 
 /// Linkage check and, with IPEC on, the correction of both trucks (odo_ipec.h). Returns faults.
-static uint32_t ipec_tick(odo_app_t *app, const odo_tick_input_t *in, bool dr_ok,
-                          uint8_t pose_flags[ODO_TRUCKS], odo_tick_output_t *out)
+static uint32_t ipec_tick(odo_app_t *app, const odo_tick_input_t *in, bool dr_ok, uint8_t pose_flags[ODO_TRUCKS],
+                          odo_tick_output_t *out)
 {
     odo_ipec_reading_t rd;
     uint32_t f = odo_ipec_check(&app->ipec, &app->params, &in->link, &rd);
@@ -189,11 +188,11 @@ static uint32_t ipec_tick(odo_app_t *app, const odo_tick_input_t *in, bool dr_ok
 
 /// One truck's wheel sample: sequence and decoder checks, then odometry over the ticks elapsed.
 /// Returns odo_step_t.range (the pose is beyond ODO_POSE_LIMIT_MM_Q32).
-static bool wheel_step(odo_app_t *app, uint8_t i, const odo_wheel_input_t *w, uint64_t t_us,
-                       uint32_t *faults, uint8_t *pose_flags, bool *dr_ok, odo_tick_output_t *out)
+static bool wheel_step(odo_app_t *app, uint8_t i, const odo_wheel_input_t *w, uint64_t t_us, uint32_t *faults,
+                       uint8_t *pose_flags, bool *dr_ok, odo_tick_output_t *out)
 {
-    if ((w->status & (ODO_WHEEL_STATUS_LEFT_SKIPPED | ODO_WHEEL_STATUS_RIGHT_SKIPPED |
-                      ODO_WHEEL_STATUS_LEFT_FAULT | ODO_WHEEL_STATUS_RIGHT_FAULT)) != 0U) {
+    if ((w->status & (ODO_WHEEL_STATUS_LEFT_SKIPPED | ODO_WHEEL_STATUS_RIGHT_SKIPPED | ODO_WHEEL_STATUS_LEFT_FAULT |
+                      ODO_WHEEL_STATUS_RIGHT_FAULT)) != 0U) {
         *faults |= FAULT_DECODER[i];
     }
     uint32_t ticks = 1U;

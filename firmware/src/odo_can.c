@@ -61,7 +61,10 @@ static const odo_can_signal_info_t sig_status[] = {
 };
 
 #define N_SIGNALS(table) ((uint8_t)(sizeof(table) / sizeof((table)[0])))
-#define MSG(name, id, dlc, table) {(name), (id), (dlc), N_SIGNALS(table), (table)}
+#define MSG(name, id, dlc, table)                      \
+    {                                                  \
+        (name), (id), (dlc), N_SIGNALS(table), (table) \
+    }
 
 /* Indexed by odo_can_msg_t; entry 0 (UNKNOWN) is never returned. */
 static const odo_can_msg_info_t msg_table[ODO_CAN_MSG_COUNT + 1U] = {
@@ -70,18 +73,13 @@ static const odo_can_msg_info_t msg_table[ODO_CAN_MSG_COUNT + 1U] = {
         MSG("WHEEL_COUNTS_A", ODO_CAN_ID_WHEEL_COUNTS_A, ODO_CAN_DLC_WHEEL_COUNTS, sig_wheel_counts),
     [ODO_CAN_MSG_WHEEL_COUNTS_B] =
         MSG("WHEEL_COUNTS_B", ODO_CAN_ID_WHEEL_COUNTS_B, ODO_CAN_DLC_WHEEL_COUNTS, sig_wheel_counts),
-    [ODO_CAN_MSG_LINK_ROTARY] =
-        MSG("LINK_ROTARY", ODO_CAN_ID_LINK_ROTARY, ODO_CAN_DLC_LINK_ROTARY, sig_link_rotary),
-    [ODO_CAN_MSG_LINK_LINEAR] =
-        MSG("LINK_LINEAR", ODO_CAN_ID_LINK_LINEAR, ODO_CAN_DLC_LINK_LINEAR, sig_link_linear),
+    [ODO_CAN_MSG_LINK_ROTARY] = MSG("LINK_ROTARY", ODO_CAN_ID_LINK_ROTARY, ODO_CAN_DLC_LINK_ROTARY, sig_link_rotary),
+    [ODO_CAN_MSG_LINK_LINEAR] = MSG("LINK_LINEAR", ODO_CAN_ID_LINK_LINEAR, ODO_CAN_DLC_LINK_LINEAR, sig_link_linear),
     [ODO_CAN_MSG_POSE_XY_A] = MSG("POSE_XY_A", ODO_CAN_ID_POSE_XY_A, ODO_CAN_DLC_POSE_XY, sig_pose_xy),
-    [ODO_CAN_MSG_POSE_THETA_A] =
-        MSG("POSE_THETA_A", ODO_CAN_ID_POSE_THETA_A, ODO_CAN_DLC_POSE_THETA, sig_pose_theta),
+    [ODO_CAN_MSG_POSE_THETA_A] = MSG("POSE_THETA_A", ODO_CAN_ID_POSE_THETA_A, ODO_CAN_DLC_POSE_THETA, sig_pose_theta),
     [ODO_CAN_MSG_POSE_XY_B] = MSG("POSE_XY_B", ODO_CAN_ID_POSE_XY_B, ODO_CAN_DLC_POSE_XY, sig_pose_xy),
-    [ODO_CAN_MSG_POSE_THETA_B] =
-        MSG("POSE_THETA_B", ODO_CAN_ID_POSE_THETA_B, ODO_CAN_DLC_POSE_THETA, sig_pose_theta),
-    [ODO_CAN_MSG_IPEC_CORR] =
-        MSG("IPEC_CORR", ODO_CAN_ID_IPEC_CORR, ODO_CAN_DLC_IPEC_CORR, sig_ipec_corr),
+    [ODO_CAN_MSG_POSE_THETA_B] = MSG("POSE_THETA_B", ODO_CAN_ID_POSE_THETA_B, ODO_CAN_DLC_POSE_THETA, sig_pose_theta),
+    [ODO_CAN_MSG_IPEC_CORR] = MSG("IPEC_CORR", ODO_CAN_ID_IPEC_CORR, ODO_CAN_DLC_IPEC_CORR, sig_ipec_corr),
     [ODO_CAN_MSG_STATUS] = MSG("STATUS", ODO_CAN_ID_STATUS, ODO_CAN_DLC_STATUS, sig_status),
 };
 
@@ -124,8 +122,8 @@ static int32_t get_s(uint64_t payload, const odo_can_signal_info_t *s)
 static void frame_store(odo_can_msg_t m, uint64_t payload, odo_can_frame_t *f)
 {
     const odo_can_msg_info_t *info = &msg_table[m];
-    f->id    = info->id;
-    f->dlc   = info->dlc;
+    f->id = info->id;
+    f->dlc = info->dlc;
     f->flags = 0U;
     for (uint8_t i = 0U; i < 8U; i++) {
         f->data[i] = (uint8_t)((i < info->dlc) ? (payload >> (8U * i)) : 0U);
@@ -135,8 +133,8 @@ static void frame_store(odo_can_msg_t m, uint64_t payload, odo_can_frame_t *f)
 /* Accept a frame of message a (*which = ODO_TRUCK_A) or b (*which = ODO_TRUCK_B); pass a == b for
    messages that are not per truck.
    Only the DLC bytes are read, so stale bytes beyond it cannot leak into a signal. */
-static odo_can_result_t frame_load(const odo_can_frame_t *f, odo_can_msg_t a, odo_can_msg_t b,
-                                   uint8_t *which, uint64_t *payload)
+static odo_can_result_t frame_load(const odo_can_frame_t *f, odo_can_msg_t a, odo_can_msg_t b, uint8_t *which,
+                                   uint64_t *payload)
 {
     if ((f->flags & FRAME_FLAGS_NOT_OURS) != 0U) {
         return ODO_CAN_ERR_FLAGS;
@@ -156,15 +154,12 @@ static odo_can_result_t frame_load(const odo_can_frame_t *f, odo_can_msg_t a, od
     for (uint8_t i = 0U; i < f->dlc; i++) {
         p |= (uint64_t)f->data[i] << (8U * i);
     }
-    *which   = w;
+    *which = w;
     *payload = p;
     return ODO_CAN_OK;
 }
 
-static bool msg_valid(odo_can_msg_t m)
-{
-    return ((unsigned)m >= 1U) && ((unsigned)m <= ODO_CAN_MSG_COUNT);
-}
+static bool msg_valid(odo_can_msg_t m) { return ((unsigned)m >= 1U) && ((unsigned)m <= ODO_CAN_MSG_COUNT); }
 
 odo_can_msg_t odo_can_classify(const odo_can_frame_t *f)
 {
@@ -179,20 +174,11 @@ odo_can_msg_t odo_can_classify(const odo_can_frame_t *f)
     return ODO_CAN_MSG_UNKNOWN;
 }
 
-uint8_t odo_can_expected_dlc(odo_can_msg_t m)
-{
-    return msg_valid(m) ? msg_table[m].dlc : 0U;
-}
+uint8_t odo_can_expected_dlc(odo_can_msg_t m) { return msg_valid(m) ? msg_table[m].dlc : 0U; }
 
-const odo_can_msg_info_t *odo_can_msg_info(odo_can_msg_t m)
-{
-    return msg_valid(m) ? &msg_table[m] : NULL;
-}
+const odo_can_msg_info_t *odo_can_msg_info(odo_can_msg_t m) { return msg_valid(m) ? &msg_table[m] : NULL; }
 
-uint8_t odo_can_seq_delta(uint8_t prev_seq, uint8_t seq)
-{
-    return (uint8_t)(seq - prev_seq);
-}
+uint8_t odo_can_seq_delta(uint8_t prev_seq, uint8_t seq) { return (uint8_t)(seq - prev_seq); }
 
 /* ---- Messages: which field goes to which signal, nothing else. ---- */
 
@@ -206,19 +192,17 @@ void odo_can_pack_wheel_counts(uint8_t truck, const odo_msg_wheel_counts_t *m, o
     frame_store(truck == ODO_TRUCK_A ? ODO_CAN_MSG_WHEEL_COUNTS_A : ODO_CAN_MSG_WHEEL_COUNTS_B, p, f);
 }
 
-odo_can_result_t odo_can_unpack_wheel_counts(const odo_can_frame_t *f, uint8_t *truck,
-                                             odo_msg_wheel_counts_t *m)
+odo_can_result_t odo_can_unpack_wheel_counts(const odo_can_frame_t *f, uint8_t *truck, odo_msg_wheel_counts_t *m)
 {
     uint64_t p;
-    uint8_t  w;
-    odo_can_result_t r =
-        frame_load(f, ODO_CAN_MSG_WHEEL_COUNTS_A, ODO_CAN_MSG_WHEEL_COUNTS_B, &w, &p);
+    uint8_t w;
+    odo_can_result_t r = frame_load(f, ODO_CAN_MSG_WHEEL_COUNTS_A, ODO_CAN_MSG_WHEEL_COUNTS_B, &w, &p);
     if (r == ODO_CAN_OK) {
-        *truck         = w;
-        m->left_count  = get_u(p, &sig_wheel_counts[WC_LEFT]);
+        *truck = w;
+        m->left_count = get_u(p, &sig_wheel_counts[WC_LEFT]);
         m->right_count = get_u(p, &sig_wheel_counts[WC_RIGHT]);
-        m->seq         = (uint8_t)get_u(p, &sig_wheel_counts[WC_SEQ]);
-        m->status      = (uint8_t)get_u(p, &sig_wheel_counts[WC_STATUS]);
+        m->seq = (uint8_t)get_u(p, &sig_wheel_counts[WC_SEQ]);
+        m->status = (uint8_t)get_u(p, &sig_wheel_counts[WC_STATUS]);
     }
     return r;
 }
@@ -236,13 +220,13 @@ void odo_can_pack_link_rotary(const odo_msg_link_rotary_t *m, odo_can_frame_t *f
 odo_can_result_t odo_can_unpack_link_rotary(const odo_can_frame_t *f, odo_msg_link_rotary_t *m)
 {
     uint64_t p;
-    uint8_t  w;
+    uint8_t w;
     odo_can_result_t r = frame_load(f, ODO_CAN_MSG_LINK_ROTARY, ODO_CAN_MSG_LINK_ROTARY, &w, &p);
     if (r == ODO_CAN_OK) {
         m->alpha_bam16 = (uint16_t)get_u(p, &sig_link_rotary[LR_ALPHA]);
-        m->beta_bam16  = (uint16_t)get_u(p, &sig_link_rotary[LR_BETA]);
-        m->seq         = (uint8_t)get_u(p, &sig_link_rotary[LR_SEQ]);
-        m->status      = (uint8_t)get_u(p, &sig_link_rotary[LR_STATUS]);
+        m->beta_bam16 = (uint16_t)get_u(p, &sig_link_rotary[LR_BETA]);
+        m->seq = (uint8_t)get_u(p, &sig_link_rotary[LR_SEQ]);
+        m->status = (uint8_t)get_u(p, &sig_link_rotary[LR_STATUS]);
     }
     return r;
 }
@@ -259,12 +243,12 @@ void odo_can_pack_link_linear(const odo_msg_link_linear_t *m, odo_can_frame_t *f
 odo_can_result_t odo_can_unpack_link_linear(const odo_can_frame_t *f, odo_msg_link_linear_t *m)
 {
     uint64_t p;
-    uint8_t  w;
+    uint8_t w;
     odo_can_result_t r = frame_load(f, ODO_CAN_MSG_LINK_LINEAR, ODO_CAN_MSG_LINK_LINEAR, &w, &p);
     if (r == ODO_CAN_OK) {
         m->length_um = get_u(p, &sig_link_linear[LL_LENGTH]);
-        m->seq       = (uint8_t)get_u(p, &sig_link_linear[LL_SEQ]);
-        m->status    = (uint8_t)get_u(p, &sig_link_linear[LL_STATUS]);
+        m->seq = (uint8_t)get_u(p, &sig_link_linear[LL_SEQ]);
+        m->status = (uint8_t)get_u(p, &sig_link_linear[LL_STATUS]);
     }
     return r;
 }
@@ -277,14 +261,13 @@ void odo_can_pack_pose_xy(uint8_t truck, const odo_msg_pose_xy_t *m, odo_can_fra
     frame_store(truck == ODO_TRUCK_A ? ODO_CAN_MSG_POSE_XY_A : ODO_CAN_MSG_POSE_XY_B, p, f);
 }
 
-odo_can_result_t odo_can_unpack_pose_xy(const odo_can_frame_t *f, uint8_t *truck,
-                                        odo_msg_pose_xy_t *m)
+odo_can_result_t odo_can_unpack_pose_xy(const odo_can_frame_t *f, uint8_t *truck, odo_msg_pose_xy_t *m)
 {
     uint64_t p;
-    uint8_t  w;
+    uint8_t w;
     odo_can_result_t r = frame_load(f, ODO_CAN_MSG_POSE_XY_A, ODO_CAN_MSG_POSE_XY_B, &w, &p);
     if (r == ODO_CAN_OK) {
-        *truck    = w;
+        *truck = w;
         m->x_10um = get_s(p, &sig_pose_xy[PXY_X]);
         m->y_10um = get_s(p, &sig_pose_xy[PXY_Y]);
     }
@@ -300,17 +283,16 @@ void odo_can_pack_pose_theta(uint8_t truck, const odo_msg_pose_theta_t *m, odo_c
     frame_store(truck == ODO_TRUCK_A ? ODO_CAN_MSG_POSE_THETA_A : ODO_CAN_MSG_POSE_THETA_B, p, f);
 }
 
-odo_can_result_t odo_can_unpack_pose_theta(const odo_can_frame_t *f, uint8_t *truck,
-                                           odo_msg_pose_theta_t *m)
+odo_can_result_t odo_can_unpack_pose_theta(const odo_can_frame_t *f, uint8_t *truck, odo_msg_pose_theta_t *m)
 {
     uint64_t p;
-    uint8_t  w;
+    uint8_t w;
     odo_can_result_t r = frame_load(f, ODO_CAN_MSG_POSE_THETA_A, ODO_CAN_MSG_POSE_THETA_B, &w, &p);
     if (r == ODO_CAN_OK) {
-        *truck       = w;
+        *truck = w;
         m->theta_bam = get_u(p, &sig_pose_theta[PT_THETA]);
-        m->seq       = (uint8_t)get_u(p, &sig_pose_theta[PT_SEQ]);
-        m->flags     = (uint8_t)get_u(p, &sig_pose_theta[PT_FLAGS]);
+        m->seq = (uint8_t)get_u(p, &sig_pose_theta[PT_SEQ]);
+        m->flags = (uint8_t)get_u(p, &sig_pose_theta[PT_FLAGS]);
     }
     return r;
 }
@@ -326,7 +308,7 @@ void odo_can_pack_ipec_corr(const odo_msg_ipec_corr_t *m, odo_can_frame_t *f)
 odo_can_result_t odo_can_unpack_ipec_corr(const odo_can_frame_t *f, odo_msg_ipec_corr_t *m)
 {
     uint64_t p;
-    uint8_t  w;
+    uint8_t w;
     odo_can_result_t r = frame_load(f, ODO_CAN_MSG_IPEC_CORR, ODO_CAN_MSG_IPEC_CORR, &w, &p);
     if (r == ODO_CAN_OK) {
         m->dtheta_a_bam = get_s(p, &sig_ipec_corr[IC_A]);
@@ -348,13 +330,13 @@ void odo_can_pack_status(const odo_msg_status_t *m, odo_can_frame_t *f)
 odo_can_result_t odo_can_unpack_status(const odo_can_frame_t *f, odo_msg_status_t *m)
 {
     uint64_t p;
-    uint8_t  w;
+    uint8_t w;
     odo_can_result_t r = frame_load(f, ODO_CAN_MSG_STATUS, ODO_CAN_MSG_STATUS, &w, &p);
     if (r == ODO_CAN_OK) {
-        m->faults      = get_u(p, &sig_status[ST_FAULTS]);
-        m->seq         = (uint8_t)get_u(p, &sig_status[ST_SEQ]);
+        m->faults = get_u(p, &sig_status[ST_FAULTS]);
+        m->seq = (uint8_t)get_u(p, &sig_status[ST_SEQ]);
         m->param_state = (uint8_t)get_u(p, &sig_status[ST_PARAM_STATE]);
-        m->rejected    = (uint16_t)get_u(p, &sig_status[ST_REJECTED]);
+        m->rejected = (uint16_t)get_u(p, &sig_status[ST_REJECTED]);
     }
     return r;
 }

@@ -8,15 +8,9 @@
 /// 2^32 / 10^6 in Q18: nm -> mm Q32 (relative error 1.4e-10).
 #define NM_TO_MM_Q32_K18 1125899907L
 
-int64_t odo_ipec_nm_to_mm_q32(int64_t nm)
-{
-    return odo_mul_s64_s32_shr(nm, (int32_t)NM_TO_MM_Q32_K18, 18U);
-}
+int64_t odo_ipec_nm_to_mm_q32(int64_t nm) { return odo_mul_s64_s32_shr(nm, (int32_t)NM_TO_MM_Q32_K18, 18U); }
 
-void odo_ipec_init(odo_ipec_t *s)
-{
-    memset(s, 0, sizeof *s);
-}
+void odo_ipec_init(odo_ipec_t *s) { memset(s, 0, sizeof *s); }
 
 static uint32_t abs_diff_bam16(uint16_t a, uint16_t b)
 {
@@ -25,10 +19,7 @@ static uint32_t abs_diff_bam16(uint16_t a, uint16_t b)
 }
 
 /// Half a rotary step, in BAM.
-static uint32_t half_step_bam(uint8_t rotary_bits)
-{
-    return 1UL << (31U - rotary_bits);
-}
+static uint32_t half_step_bam(uint8_t rotary_bits) { return 1UL << (31U - rotary_bits); }
 
 static int32_t decode_angle(uint16_t code_bam16, int32_t bias_bam, uint8_t rotary_bits)
 {
@@ -36,16 +27,15 @@ static int32_t decode_angle(uint16_t code_bam16, int32_t bias_bam, uint8_t rotar
     return (int32_t)(((uint32_t)code_bam16 << 16) + half_step_bam(rotary_bits) - (uint32_t)bias_bam);
 }
 
-uint32_t odo_ipec_check(odo_ipec_t *s, const odo_params_t *p, const odo_link_input_t *in,
-                        odo_ipec_reading_t *rd)
+uint32_t odo_ipec_check(odo_ipec_t *s, const odo_params_t *p, const odo_link_input_t *in, odo_ipec_reading_t *rd)
 {
     const odo_link_params_t *lp = &p->link;
     const bool clapper = p->vehicle == (uint8_t)ODO_VEHICLE_CLAPPER;
     if (s->age_ticks != UINT32_MAX) {
         s->age_ticks++;
     }
-    const uint8_t need_rot = (uint8_t)(clapper ? (ODO_LINK_STATUS_ALPHA_VALID | ODO_LINK_STATUS_BETA_VALID)
-                                               : ODO_LINK_STATUS_ALPHA_VALID);
+    const uint8_t need_rot =
+        (uint8_t)(clapper ? (ODO_LINK_STATUS_ALPHA_VALID | ODO_LINK_STATUS_BETA_VALID) : ODO_LINK_STATUS_ALPHA_VALID);
     const bool rot_ok = in->rotary_present && (in->rotary_status & need_rot) == need_rot;
     const bool lin_ok = !clapper || (in->linear_present && (in->linear_status & ODO_LINK_STATUS_LENGTH_VALID) != 0U);
     if (!rot_ok || !lin_ok) {
@@ -75,8 +65,8 @@ uint32_t odo_ipec_check(odo_ipec_t *s, const odo_params_t *p, const odo_link_inp
     if (s->have_last && !stale) {
         const uint64_t max_a = (uint64_t)lp->max_jump_bam * ticks;
         const uint64_t max_l = (uint64_t)lp->max_length_jump_um * ticks;
-        const uint32_t dl_um = in->length_um > s->last_length_um ? in->length_um - s->last_length_um
-                                                                 : s->last_length_um - in->length_um;
+        const uint32_t dl_um =
+            in->length_um > s->last_length_um ? in->length_um - s->last_length_um : s->last_length_um - in->length_um;
         if (abs_diff_bam16(in->alpha_bam16, s->last_alpha_bam16) > max_a ||
             (clapper && (abs_diff_bam16(in->beta_bam16, s->last_beta_bam16) > max_a || dl_um > max_l))) {
             return ODO_FAULT_LINK_JUMP;
@@ -101,8 +91,8 @@ uint32_t odo_ipec_check(odo_ipec_t *s, const odo_params_t *p, const odo_link_inp
          * relative to each other, ecc (1 - cos(alpha - beta)) (host_sim's model). */
         /* 1 - cos spans [0, 2]: 2^31 in Q30 at 180 deg, one past int32, so the product is formed
          * in int64 (|ecc| < 2^31 times <= 2^31 stays below 2^62). */
-        const int64_t one_minus_cos_q30 = (int64_t)ODO_Q30_ONE -
-                                          odo_cos_q30((uint32_t)rd->alpha_bam - (uint32_t)rd->beta_bam);
+        const int64_t one_minus_cos_q30 =
+            (int64_t)ODO_Q30_ONE - odo_cos_q30((uint32_t)rd->alpha_bam - (uint32_t)rd->beta_bam);
         const int64_t ecc_nm = odo_shr_round_s64((int64_t)lp->length_ecc_nm * one_minus_cos_q30, 30U);
         const int64_t l_nm = (int64_t)in->length_um * 1000 - lp->length_bias_nm - ecc_nm;
         rd->length_mm_q32 = odo_ipec_nm_to_mm_q32(l_nm);
@@ -132,8 +122,8 @@ void odo_ipec_anchor(const odo_pose_t *a, uint32_t theta_l_bam, int64_t length_m
     b->y_mm_q32 = a->y_mm_q32 - odo_mul_s64_s32_shr(length_mm_q32, s, 30U);
 }
 
-void odo_ipec_translate(odo_pose_t *p, int32_t dtheta_bam, int64_t dist_mm_q40,
-                        uint32_t wheelbase_nm, int64_t *dx_mm_q32, int64_t *dy_mm_q32)
+void odo_ipec_translate(odo_pose_t *p, int32_t dtheta_bam, int64_t dist_mm_q40, uint32_t wheelbase_nm,
+                        int64_t *dx_mm_q32, int64_t *dy_mm_q32)
 {
     int64_t dx = 0, dy = 0;
     if (dist_mm_q40 != 0 && dtheta_bam != 0) {
@@ -160,10 +150,7 @@ void odo_ipec_translate(odo_pose_t *p, int32_t dtheta_bam, int64_t dist_mm_q40,
     }
 }
 
-static int32_t clamp_s32(int32_t v, int32_t lim)
-{
-    return v > lim ? lim : (v < -lim ? -lim : v);
-}
+static int32_t clamp_s32(int32_t v, int32_t lim) { return v > lim ? lim : (v < -lim ? -lim : v); }
 
 int32_t odo_ipec_gain(uint8_t ipec_mode, int32_t innov_bam, uint8_t rotary_bits)
 {
@@ -178,13 +165,10 @@ int32_t odo_ipec_gain(uint8_t ipec_mode, int32_t innov_bam, uint8_t rotary_bits)
     return (innov_bam - inside) + (int32_t)odo_shr_round_s64(inside, ODO_IPEC_EST_PULL_SHIFT);
 }
 
-static uint64_t turns_q64(int32_t bam)
-{
-    return (uint64_t)((int64_t)bam * 4294967296LL);
-}
+static uint64_t turns_q64(int32_t bam) { return (uint64_t)((int64_t)bam * 4294967296LL); }
 
-void odo_ipec_step(const odo_params_t *p, const odo_ipec_reading_t *rd, odo_pose_t pose[2],
-                   int64_t dist_mm_q40, odo_ipec_result_t *out)
+void odo_ipec_step(const odo_params_t *p, const odo_ipec_reading_t *rd, odo_pose_t pose[2], int64_t dist_mm_q40,
+                   odo_ipec_result_t *out)
 {
     const bool set = p->vehicle == (uint8_t)ODO_VEHICLE_SET;
     memset(out, 0, sizeof *out);
@@ -205,8 +189,8 @@ void odo_ipec_step(const odo_params_t *p, const odo_ipec_reading_t *rd, odo_pose
          * by d hitch cos(alpha) / L the other way: alpha moves by d (1 + hitch cos(alpha) / L).
          * Divide that sensitivity out (|alpha| < 90 deg keeps it above 1). */
         const int64_t len_nm = (int64_t)p->link.length_nm;
-        int64_t den = len_nm + odo_mul_s64_s32_shr((int64_t)p->link.hitch_offset_nm,
-                                                   odo_cos_q30((uint32_t)rd->alpha_bam), 30U);
+        int64_t den =
+            len_nm + odo_mul_s64_s32_shr((int64_t)p->link.hitch_offset_nm, odo_cos_q30((uint32_t)rd->alpha_bam), 30U);
         den = den < len_nm / 4 ? len_nm / 4 : den;
         out->dtheta_bam[0] = (int32_t)(((int64_t)out->dtheta_bam[0] * len_nm) / den);
     } else {
@@ -217,8 +201,7 @@ void odo_ipec_step(const odo_params_t *p, const odo_ipec_reading_t *rd, odo_pose
     const int32_t h = (int32_t)half_step_bam(p->link.rotary_bits);
     const int32_t fast = out->dtheta_bam[0] - clamp_s32(out->dtheta_bam[0], h);
     const uint64_t b_nm = ((uint64_t)p->truck[0].wheelbase_nm * (uint64_t)(uint32_t)p->truck[0].eb_q30) >> 30;
-    odo_ipec_translate(&pose[0], fast, dist_mm_q40, (uint32_t)b_nm, &out->shift_mm_q32[0],
-                       &out->shift_mm_q32[1]);
+    odo_ipec_translate(&pose[0], fast, dist_mm_q40, (uint32_t)b_nm, &out->shift_mm_q32[0], &out->shift_mm_q32[1]);
 
     /* Eq. 13. */
     pose[0].heading_q64 += turns_q64(out->dtheta_bam[0]);

@@ -9,9 +9,9 @@
 #define PI_Q60      3622009729038561421ULL
 #define INV_2PI_Q64 2935890503282001226ULL
 
-#define Q30_ONE_U ((uint64_t)1U << 30)
+#define Q30_ONE_U     ((uint64_t)1U << 30)
 #define SCRUB_MAX_Q30 ((int32_t)ODO_SCRUB_MAX_Q30)
-#define NM_PER_MM 1000000U
+#define NM_PER_MM     1000000U
 
 /* Heading bookkeeping reads a per-tick heading change as a signed fraction of a turn, which is
  * unambiguous only below half a turn: keep each wheel's worst case below a quarter. */
@@ -23,16 +23,14 @@
 static uint64_t q60_to_q40(uint64_t v) { return (v >> 20) + ((v >> 19) & 1U); }
 
 odo_model_status_t odo_model_init(odo_model_t *m, const odo_truck_params_t *tp, uint8_t counter_bits,
-                                  uint8_t heading_form, uint32_t tick_us,
-                                  uint32_t max_wheel_speed_mm_s)
+                                  uint8_t heading_form, uint32_t tick_us, uint32_t max_wheel_speed_mm_s)
 {
     const uint64_t ed = (uint64_t)(uint32_t)tp->ed_q30;
     const uint64_t eb = (uint64_t)(uint32_t)tp->eb_q30;
     const uint64_t es = (uint64_t)(uint32_t)tp->es_q30;
     if (tp->ed_q30 <= 0 || tp->eb_q30 <= 0 || tp->es_q30 <= 0 || tp->wheelbase_nm == 0U ||
-        tp->counts_per_rev_milli == 0U || counter_bits < ODO_COUNTER_BITS_MIN ||
-        counter_bits > ODO_COUNTER_BITS_MAX || tp->scrub_q30 < -SCRUB_MAX_Q30 ||
-        tp->scrub_q30 > SCRUB_MAX_Q30) {
+        tp->counts_per_rev_milli == 0U || counter_bits < ODO_COUNTER_BITS_MIN || counter_bits > ODO_COUNTER_BITS_MAX ||
+        tp->scrub_q30 < -SCRUB_MAX_Q30 || tp->scrub_q30 > SCRUB_MAX_Q30) {
         return ODO_MODEL_ERR_RANGE;
     }
 
@@ -72,8 +70,7 @@ odo_model_status_t odo_model_init(odo_model_t *m, const odo_truck_params_t *tp, 
     /* Largest believable count change per tick: the faster wheel at max speed, plus one count.
      * counts = (v * tick) / k = d_um * 2^40 / (1000 * k_q40), using the smaller k. */
     const uint64_t d_um = ((uint64_t)max_wheel_speed_mm_s * tick_us + 999U) / 1000U;
-    const uint64_t k_min = (uint64_t)(mm.dist_mm_q40[0] < mm.dist_mm_q40[1] ? mm.dist_mm_q40[0]
-                                                                            : mm.dist_mm_q40[1]);
+    const uint64_t k_min = (uint64_t)(mm.dist_mm_q40[0] < mm.dist_mm_q40[1] ? mm.dist_mm_q40[0] : mm.dist_mm_q40[1]);
     uint64_t max_counts;
     if (!odo_muldiv_u64(d_um, (uint64_t)1U << 40, 1000U * k_min, &max_counts)) {
         return ODO_MODEL_ERR_RANGE;
@@ -137,10 +134,7 @@ void odo_truck_reset(odo_truck_t *t, const odo_pose_t *pose)
 }
 
 /// Reinterpret a uint64 as two's complement int64 without implementation-defined conversion.
-static int64_t as_signed(uint64_t u)
-{
-    return u <= (uint64_t)INT64_MAX ? (int64_t)u : -(int64_t)(~u) - 1;
-}
+static int64_t as_signed(uint64_t u) { return u <= (uint64_t)INT64_MAX ? (int64_t)u : -(int64_t)(~u) - 1; }
 
 /// |v| as unsigned; exact for INT32_MIN.
 static uint32_t mag32(int32_t v) { return v < 0 ? 0U - (uint32_t)v : (uint32_t)v; }
@@ -161,10 +155,10 @@ static int32_t sinc_half_q30(int64_t dturn_q64)
 {
     /* x in rad Q30 = pi * dturn / 2^64 * 2^30 = dturn * (pi * 2^29) / 2^63; |x| < pi/2 */
     const int64_t x = odo_mul_s64_s32_shr(dturn_q64, 1686629713, 63U);
-    const int64_t x2 = (x * x) >> 30; /* x^2 in Q30, < 2.65e9 */
-    int64_t p = ODO_Q30_ONE - ((x2 * 25565282) >> 30);             /* 1 - x^2/42 */
-    p = ODO_Q30_ONE - ((((x2 * p) >> 30) * 53687091) >> 30);       /* 1 - x^2/20 (...) */
-    p = ODO_Q30_ONE - ((((x2 * p) >> 30) * 178956971) >> 30);      /* 1 - x^2/6 (...) */
+    const int64_t x2 = (x * x) >> 30;                         /* x^2 in Q30, < 2.65e9 */
+    int64_t p = ODO_Q30_ONE - ((x2 * 25565282) >> 30);        /* 1 - x^2/42 */
+    p = ODO_Q30_ONE - ((((x2 * p) >> 30) * 53687091) >> 30);  /* 1 - x^2/20 (...) */
+    p = ODO_Q30_ONE - ((((x2 * p) >> 30) * 178956971) >> 30); /* 1 - x^2/6 (...) */
     return (int32_t)p;
 }
 
@@ -178,16 +172,16 @@ int64_t odo_scrub_dturn(const odo_model_t *m, int32_t d_left, int32_t d_right)
     const uint32_t v = a + b;                 /* < 2^32: |d| <= max_delta_counts < 2^31 */
     const uint32_t mv = 2U * (a < b ? a : b); /* <= v */
     /* k * dtheta from the k-scaled multipliers, with the same exact modular sum as Eq. 2.4. */
-    const int64_t k_dturn = as_signed(m->scrub_turn_q64[1] * (uint64_t)(int64_t)d[1] -
-                                      m->scrub_turn_q64[0] * (uint64_t)(int64_t)d[0]);
+    const int64_t k_dturn =
+        as_signed(m->scrub_turn_q64[1] * (uint64_t)(int64_t)d[1] - m->scrub_turn_q64[0] * (uint64_t)(int64_t)d[0]);
     if (mv == v) {
         return k_dturn; /* equal wheels: m / v = 1 (does not fit Q32) */
     }
     return odo_mul_s64_u32_shr(k_dturn, odo_frac_q32(mv, v), 32U);
 }
 
-void odo_truck_step(odo_truck_t *t, const odo_model_t *m, uint32_t left_raw, uint32_t right_raw,
-                    uint8_t bits, uint32_t ticks, odo_step_t *out)
+void odo_truck_step(odo_truck_t *t, const odo_model_t *m, uint32_t left_raw, uint32_t right_raw, uint8_t bits,
+                    uint32_t ticks, odo_step_t *out)
 {
     const uint32_t raw[2] = {left_raw, right_raw};
     const uint8_t w_bits = bits < m->counter_bits ? bits : m->counter_bits;
@@ -243,8 +237,7 @@ void odo_truck_step(odo_truck_t *t, const odo_model_t *m, uint32_t left_raw, uin
     const int64_t dist = odo_shr_round_s64(s_l + s_r, 1U);
     /* Eq. 2.4 in turns: modular arithmetic on uint64 is exact whatever the size of d; read as a
      * signed change it is below a quarter turn per tick elapsed (checked at init). */
-    const uint64_t dturn_u = m->turn_q64[1] * (uint64_t)(int64_t)d[1] -
-                             m->turn_q64[0] * (uint64_t)(int64_t)d[0];
+    const uint64_t dturn_u = m->turn_q64[1] * (uint64_t)(int64_t)d[1] - m->turn_q64[0] * (uint64_t)(int64_t)d[0];
     int64_t dturn = as_signed(dturn_u);
     if (m->scrub_q30 != 0) {
         /* g = 1 - k m / v, |k m / v| <= 1/4; modulo a turn, as a gap's dturn may be near half a
@@ -272,9 +265,8 @@ void odo_pose_advance(odo_pose_t *p, int64_t dist_mm_q40, int64_t dturn_q64, uin
     const uint64_t h_new = p->heading_q64 + (uint64_t)dturn_q64;
     /* Eq. 2.6 advances along the new heading; the midpoint form along theta_{i-1} + dtheta/2,
      * which is exact in direction for a constant-curvature arc (second-order accurate). */
-    const uint64_t h_dir = (heading_form == (uint8_t)ODO_HEADING_PAPER)
-                               ? h_new
-                               : p->heading_q64 + (uint64_t)(dturn_q64 / 2);
+    const uint64_t h_dir =
+        (heading_form == (uint8_t)ODO_HEADING_PAPER) ? h_new : p->heading_q64 + (uint64_t)(dturn_q64 / 2);
     int32_t s, c;
     odo_sincos_q30((uint32_t)((h_dir + 0x80000000ULL) >> 32), &s, &c);
     /* Q40 mm * Q30 -> Q32 mm: shift by 38. */
@@ -283,10 +275,7 @@ void odo_pose_advance(odo_pose_t *p, int64_t dist_mm_q40, int64_t dturn_q64, uin
     p->heading_q64 = h_new;
 }
 
-uint32_t odo_heading_bam(const odo_pose_t *p)
-{
-    return (uint32_t)((p->heading_q64 + 0x80000000ULL) >> 32);
-}
+uint32_t odo_heading_bam(const odo_pose_t *p) { return (uint32_t)((p->heading_q64 + 0x80000000ULL) >> 32); }
 
 int32_t odo_mm_q32_to_10um(int64_t v_mm_q32, bool *saturated)
 {

@@ -184,19 +184,31 @@ static unsigned excess_bits_over_32(uint64_t v)
 {
     uint32_t h = (uint32_t)(v >> 32);
     unsigned n = 0U;
-    if (h >= ((uint32_t)1U << 16)) { h >>= 16; n += 16U; }
-    if (h >= ((uint32_t)1U << 8)) { h >>= 8; n += 8U; }
-    if (h >= ((uint32_t)1U << 4)) { h >>= 4; n += 4U; }
-    if (h >= ((uint32_t)1U << 2)) { h >>= 2; n += 2U; }
-    if (h >= ((uint32_t)1U << 1)) { h >>= 1; n += 1U; }
+    if (h >= ((uint32_t)1U << 16)) {
+        h >>= 16;
+        n += 16U;
+    }
+    if (h >= ((uint32_t)1U << 8)) {
+        h >>= 8;
+        n += 8U;
+    }
+    if (h >= ((uint32_t)1U << 4)) {
+        h >>= 4;
+        n += 4U;
+    }
+    if (h >= ((uint32_t)1U << 2)) {
+        h >>= 2;
+        n += 2U;
+    }
+    if (h >= ((uint32_t)1U << 1)) {
+        h >>= 1;
+        n += 1U;
+    }
     return n + (unsigned)h;
 }
 
 /// v / 2^s rounded to nearest, s in [0, 32]; v <= 2^63 so the bias cannot overflow.
-static uint64_t shr_round_u64(uint64_t v, unsigned s)
-{
-    return s == 0U ? v : (v + ((uint64_t)1U << (s - 1U))) >> s;
-}
+static uint64_t shr_round_u64(uint64_t v, unsigned s) { return s == 0U ? v : (v + ((uint64_t)1U << (s - 1U))) >> s; }
 
 uint32_t odo_atan2_bam(int64_t y, int64_t x)
 {

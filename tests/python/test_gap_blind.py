@@ -66,7 +66,7 @@ def test_an_existing_folder_that_is_not_a_blind_output_is_not_replaced(tmp_path:
     r = subprocess.run([PY, "-m", "odo_tools.gap.cli", "blind", "--cases", "1", "--seed", "1",
                         "--out", str(out), "--quiet"], env=env(), capture_output=True, text=True,
                        timeout=300)
-    assert r.returncode == 1 and "not replaced" in r.stderr
+    assert r.returncode == 1 and "did not write" in r.stderr
     assert (out / "notes.txt").read_text() == "keep me"
 
 

@@ -94,27 +94,27 @@ typedef enum {
 /// Result of an unpacker. Map to faults as: ERR_FLAGS with ODO_CAN_FLAG_ERR -> ODO_FAULT_BUS_ERROR,
 /// ERR_ID -> ODO_FAULT_CAN_UNKNOWN_ID, ERR_DLC -> ODO_FAULT_CAN_BAD_DLC.
 typedef enum {
-    ODO_CAN_OK = 0,    ///< decoded; outputs written
-    ODO_CAN_ERR_ID,    ///< identifier is not this message's
-    ODO_CAN_ERR_DLC,   ///< right identifier, wrong length: a sender on another protocol version
-    ODO_CAN_ERR_FLAGS  ///< RTR, error or extended-identifier frame: not one of our data frames
+    ODO_CAN_OK = 0,   ///< decoded; outputs written
+    ODO_CAN_ERR_ID,   ///< identifier is not this message's
+    ODO_CAN_ERR_DLC,  ///< right identifier, wrong length: a sender on another protocol version
+    ODO_CAN_ERR_FLAGS ///< RTR, error or extended-identifier frame: not one of our data frames
 } odo_can_result_t;
 
 /// Layout of one signal as the codec uses it; mirrors the DBC's SG_ line. All signals are
 /// little-endian integers with start_bit + bit_len <= 8 * dlc of their message.
 typedef struct {
-    const char *name;      ///< DBC signal name, e.g. "LeftCount"
-    uint8_t     start_bit; ///< DBC start bit: position of the least significant bit, 0..63
-    uint8_t     bit_len;   ///< 1..32
-    bool        is_signed; ///< two's complement
+    const char *name;  ///< DBC signal name, e.g. "LeftCount"
+    uint8_t start_bit; ///< DBC start bit: position of the least significant bit, 0..63
+    uint8_t bit_len;   ///< 1..32
+    bool is_signed;    ///< two's complement
 } odo_can_signal_info_t;
 
 /// Layout of one message; the table behind every pack/unpack function.
 typedef struct {
-    const char                  *name;      ///< DBC message name, e.g. "POSE_XY_A"
-    uint32_t                     id;        ///< 11-bit identifier
-    uint8_t                      dlc;       ///< exact data length
-    uint8_t                      n_signals; ///< entries in signals[], in DBC order
+    const char *name;  ///< DBC message name, e.g. "POSE_XY_A"
+    uint32_t id;       ///< 11-bit identifier
+    uint8_t dlc;       ///< exact data length
+    uint8_t n_signals; ///< entries in signals[], in DBC order
     const odo_can_signal_info_t *signals;
 } odo_can_msg_info_t;
 
@@ -122,23 +122,23 @@ typedef struct {
 typedef struct {
     uint32_t left_count;  ///< LeftCount: decoder position, counts; low 24 bits on the wire
     uint32_t right_count; ///< RightCount: decoder position, counts; low 24 bits on the wire
-    uint8_t  seq;         ///< Seq: sample sequence number, wraps at 256
-    uint8_t  status;      ///< Status: ODO_WHEEL_STATUS_* bits
+    uint8_t seq;          ///< Seq: sample sequence number, wraps at 256
+    uint8_t status;       ///< Status: ODO_WHEEL_STATUS_* bits
 } odo_msg_wheel_counts_t;
 
 /// LINK_ROTARY: one sample of the linkage rotary encoders.
 typedef struct {
     uint16_t alpha_bam16; ///< Alpha: 2^16 per turn; an n-bit encoder code shifted left by 16 - n
     uint16_t beta_bam16;  ///< Beta: 2^16 per turn (clapper only)
-    uint8_t  seq;         ///< Seq: sample sequence number, wraps at 256
-    uint8_t  status;      ///< Status: ODO_LINK_STATUS_ALPHA_VALID | ODO_LINK_STATUS_BETA_VALID
+    uint8_t seq;          ///< Seq: sample sequence number, wraps at 256
+    uint8_t status;       ///< Status: ODO_LINK_STATUS_ALPHA_VALID | ODO_LINK_STATUS_BETA_VALID
 } odo_msg_link_rotary_t;
 
 /// LINK_LINEAR: one sample of the linkage linear encoder.
 typedef struct {
     uint32_t length_um; ///< Length: centre-to-centre link length, micrometres
-    uint8_t  seq;       ///< Seq: sample sequence number, wraps at 256
-    uint8_t  status;    ///< Status: ODO_LINK_STATUS_LENGTH_VALID
+    uint8_t seq;        ///< Seq: sample sequence number, wraps at 256
+    uint8_t status;     ///< Status: ODO_LINK_STATUS_LENGTH_VALID
 } odo_msg_link_linear_t;
 
 /// POSE_XY_A / POSE_XY_B: position of a truck in the odometry frame.
@@ -150,8 +150,8 @@ typedef struct {
 /// POSE_THETA_A / POSE_THETA_B: heading of a truck.
 typedef struct {
     uint32_t theta_bam; ///< Theta: binary angle, 2^32 per turn, ccw from +x
-    uint8_t  seq;       ///< Seq: output sequence number of the tick, wraps at 256
-    uint8_t  flags;     ///< Flags: pose qualifier bits, defined by the application (odo_app.h)
+    uint8_t seq;        ///< Seq: output sequence number of the tick, wraps at 256
+    uint8_t flags;      ///< Flags: pose qualifier bits, defined by the application (odo_app.h)
 } odo_msg_pose_theta_t;
 
 /// IPEC_CORR: heading corrections applied this tick (002 Eqs. 9-16).
@@ -162,10 +162,10 @@ typedef struct {
 
 /// STATUS: firmware status of the tick.
 typedef struct {
-    uint32_t faults;      ///< Faults: ODO_FAULT_* bits raised this tick
-    uint8_t  seq;         ///< Seq: output sequence number of the tick, wraps at 256
-    uint8_t  param_state; ///< ParamState: odo_params_status_t of the boot-time load (0 = OK)
-    uint16_t rejected;    ///< Rejected: frames rejected since boot, saturating at 65535
+    uint32_t faults;     ///< Faults: ODO_FAULT_* bits raised this tick
+    uint8_t seq;         ///< Seq: output sequence number of the tick, wraps at 256
+    uint8_t param_state; ///< ParamState: odo_params_status_t of the boot-time load (0 = OK)
+    uint16_t rejected;   ///< Rejected: frames rejected since boot, saturating at 65535
 } odo_msg_status_t;
 
 /// Which known message a frame is, by identifier. Returns ODO_CAN_MSG_UNKNOWN iff the frame has
@@ -191,8 +191,7 @@ void odo_can_pack_wheel_counts(uint8_t truck, const odo_msg_wheel_counts_t *m, o
 
 /// Decode 0x110 or 0x111; *truck receives ODO_TRUCK_A or ODO_TRUCK_B. Counts come back in
 /// [0, ODO_CAN_COUNT_MASK]. ERR_ID for any other identifier. *truck and *m untouched on error.
-odo_can_result_t odo_can_unpack_wheel_counts(const odo_can_frame_t *f, uint8_t *truck,
-                                             odo_msg_wheel_counts_t *m);
+odo_can_result_t odo_can_unpack_wheel_counts(const odo_can_frame_t *f, uint8_t *truck, odo_msg_wheel_counts_t *m);
 
 /// LINK_ROTARY (0x120, DLC 6).
 void odo_can_pack_link_rotary(const odo_msg_link_rotary_t *m, odo_can_frame_t *f);
@@ -212,16 +211,14 @@ void odo_can_pack_pose_xy(uint8_t truck, const odo_msg_pose_xy_t *m, odo_can_fra
 
 /// Decode 0x180 or 0x182; *truck receives ODO_TRUCK_A or ODO_TRUCK_B. *truck and *m untouched on
 /// error.
-odo_can_result_t odo_can_unpack_pose_xy(const odo_can_frame_t *f, uint8_t *truck,
-                                        odo_msg_pose_xy_t *m);
+odo_can_result_t odo_can_unpack_pose_xy(const odo_can_frame_t *f, uint8_t *truck, odo_msg_pose_xy_t *m);
 
 /// POSE_THETA: truck ODO_TRUCK_A -> 0x181, ODO_TRUCK_B -> 0x183 (any other value is sent as B).
 void odo_can_pack_pose_theta(uint8_t truck, const odo_msg_pose_theta_t *m, odo_can_frame_t *f);
 
 /// Decode 0x181 or 0x183; *truck receives ODO_TRUCK_A or ODO_TRUCK_B. *truck and *m untouched on
 /// error.
-odo_can_result_t odo_can_unpack_pose_theta(const odo_can_frame_t *f, uint8_t *truck,
-                                           odo_msg_pose_theta_t *m);
+odo_can_result_t odo_can_unpack_pose_theta(const odo_can_frame_t *f, uint8_t *truck, odo_msg_pose_theta_t *m);
 
 /// IPEC_CORR (0x190).
 void odo_can_pack_ipec_corr(const odo_msg_ipec_corr_t *m, odo_can_frame_t *f);

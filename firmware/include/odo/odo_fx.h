@@ -69,7 +69,7 @@ int64_t odo_shr_round_s64(int64_t v, unsigned shift);
 /// sin and cos of a binary angle, Q30. Constant time (octant fold + short polynomial).
 int32_t odo_sin_q30(uint32_t angle_bam);
 int32_t odo_cos_q30(uint32_t angle_bam);
-void    odo_sincos_q30(uint32_t angle_bam, int32_t *sin_q30, int32_t *cos_q30);
+void odo_sincos_q30(uint32_t angle_bam, int32_t *sin_q30, int32_t *cos_q30);
 
 /// Angle of the vector (x, y) as a BAM in [0, 2^32): atan2(y, x) mapped so that +x is 0 and +y is
 /// ODO_BAM_QUARTER. Any int64 inputs are valid, INT64_MIN included; (0, 0) returns 0. Constant time

@@ -39,9 +39,9 @@ def main(argv: list[str] | None = None) -> int:
         help="diagnose recorded runs (never reads a scenario)",
         description="Where the gap between the nominal model and recorded runs lies, which "
         "effect causes it, and how far it shrinks on held-out runs. Writes OUT/report.md, "
-        "report.json and plots (built in a fresh OUT.tmp.* folder and moved into place; an "
-        "existing OUT is refused unless it holds odo-gap's manifest, and then only the files "
-        "that manifest lists are replaced).",
+        "report.json and plots by the output rule: built in a fresh temp folder beside OUT and "
+        "moved into place; an existing OUT is written into only when it holds odo-gap's "
+        "manifest (then only the files it lists are replaced) or with --force.",
     )
     d.add_argument(
         "--real",
@@ -92,6 +92,12 @@ def main(argv: list[str] | None = None) -> int:
         "judged against the larger of it and the runs' own spread",
     )
     d.add_argument("--out", required=True)
+    d.add_argument(
+        "--force",
+        action="store_true",
+        help="write into a non-empty OUT odo-gap did not write (same-named files replaced, "
+        "nothing removed)",
+    )
     d.add_argument("--quiet", action="store_true")
     b = sub.add_parser(
         "blind",
@@ -109,6 +115,12 @@ def main(argv: list[str] | None = None) -> int:
         "effect law with it (validation.indep); both: each, scored separately",
     )
     b.add_argument("--out", required=True)
+    b.add_argument(
+        "--force",
+        action="store_true",
+        help="write into a non-empty OUT odo-gap blind did not write (same-named files replaced, "
+        "nothing removed)",
+    )
     b.add_argument("--workers", type=int, default=2, help="processes (at most 2)")
     b.add_argument("--quiet", action="store_true")
     a = ap.parse_args(argv)
@@ -142,7 +154,7 @@ def main(argv: list[str] | None = None) -> int:
                 judge_runs=a.judge,
                 groups=a.group,
             )
-            write_report(rep, a.out)
+            write_report(rep, a.out, a.force, [*a.real, a.robot])
             v = rep.verdict
             h = rep.heldout
             print(
@@ -163,7 +175,9 @@ def main(argv: list[str] | None = None) -> int:
             raise _Usage(f"--seed must be 0 or more, got {a.seed}")
         if a.workers < 1:
             raise _Usage(f"--workers must be at least 1, got {a.workers}")
-        run_blind(a.cases, a.seed, a.out, min(2, max(1, a.workers)), _progress(a.quiet), worlds)
+        run_blind(
+            a.cases, a.seed, a.out, min(2, max(1, a.workers)), _progress(a.quiet), worlds, a.force
+        )
         return 0
     except (GapInputError, _Usage) as e:
         print(f"odo-gap: {e}", file=sys.stderr)

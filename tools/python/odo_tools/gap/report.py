@@ -1,13 +1,10 @@
 """The diagnosis report: typed parts, report.json (every number), report.md (plain words with
-units, links to the plots, the next step), built in a fresh temp folder and moved into place
-(write_report: the output rule, a manifest of what it wrote)."""
+units, links to the plots, the next step), written by the project's output rule (outpath.py)."""
 
 from __future__ import annotations
 
 import json
 import math
-import os
-import shutil
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -580,81 +577,29 @@ def _remainder(rep: dict) -> str:
     return "; ".join(parts)
 
 
-# The manifest of the files odo-gap wrote into an output folder, in the format of the project's
-# output rule (hardening branch: tools/python/odo_tools/outpath.py, hostlib/odo_out.h): a folder
-# that holds it may have exactly those files replaced or removed; nothing else is touched.
-MANIFEST = ".odo-manifest"
-MANIFEST_MAGIC = "odo-out-manifest 1"
-MANIFEST_TOOL = "odo-gap"
-
-
-def read_manifest(folder: Path, tool: str = MANIFEST_TOOL) -> list[str] | None:
-    """The files `tool` listed in folder's manifest, or None (absent, foreign or malformed)."""
-    try:
-        lines = (folder / MANIFEST).read_text().splitlines()
-    except (OSError, UnicodeDecodeError):
-        return None
-    if len(lines) < 2 or lines[0] != MANIFEST_MAGIC or lines[1] != f"tool {tool}":
-        return None
-    names = lines[2:]
-    if any(not n or "/" in n or n in (".", "..", MANIFEST) for n in names):
-        return None
-    return names
-
-
-def manifest_text(tool: str, names: list[str]) -> str:
-    return "".join(f"{x}\n" for x in [MANIFEST_MAGIC, f"tool {tool}", *names])
-
-
-def write_report(rep: Report, out: str | Path) -> None:
-    """Everything into a fresh temp folder beside OUT, then moved into place: never a partial
-    report. An absent or empty OUT receives the folder by rename; an OUT holding odo-gap's
-    manifest has exactly the files that manifest lists replaced or removed and keeps everything
-    else (a user's notes, their own plots); any other folder, or a file, is refused. Nothing is
-    ever deleted that this tool did not write."""
-    import tempfile
-
+def write_report(
+    rep: Report, out: str | Path, force: bool = False, inputs: list | None = None
+) -> None:
+    """Report into OUT by the project's output rule (odo_tools/outpath.py): built in a fresh temp
+    folder beside OUT and moved into place, never a partial report; an existing OUT is written
+    into only when it holds odo-gap's manifest (then exactly the files that manifest lists are
+    replaced or removed, the user's other files stay) or with `force` (same-named files
+    replaced, nothing removed); an OUT that is or lies in an input is refused."""
+    from ..outpath import OutDir, OutputError
     from .errors import GapInputError
     from .plots import plot_report
 
-    out = Path(out)
-    old: list[str] | None = None
-    if out.is_symlink() or (out.exists() and not out.is_dir()):
-        raise GapInputError(out, "exists and is not a folder: not replaced")
-    if out.is_dir() and any(out.iterdir()):
-        old = read_manifest(out)
-        if old is None:
-            raise GapInputError(out, "exists and is not an odo-gap report folder: not replaced")
-    out.parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix=out.name + ".tmp.", dir=out.parent))
     try:
-        d = rep.to_dict()
-        (tmp / "report.json").write_text(json.dumps(d, indent=2, default=_json_default) + "\n")
-        (tmp / "report.md").write_text(markdown(d))
-        if rep.context is not None:
-            plot_report(d, rep.context, tmp)
-        names = sorted(p.name for p in tmp.iterdir() if p.is_file())
-        (tmp / MANIFEST).write_text(manifest_text(MANIFEST_TOOL, names))
-        if old is None:
-            if out.is_dir():
-                out.rmdir()  # empty: nothing of anyone's is lost
-            tmp.rename(out)
-            return
-        for name in names:
-            dst = out / name
-            if dst.is_symlink() or (dst.exists() and not dst.is_file()):
-                raise GapInputError(dst, "exists and is not a file odo-gap wrote: not replaced")
-        for name in names:
-            os.replace(tmp / name, out / name)
-        for name in set(old) - set(names):
-            p = out / name
-            if p.is_file() and not p.is_symlink():
-                p.unlink()  # a plot of the previous report this one does not draw
-        os.replace(tmp / MANIFEST, out / MANIFEST)
-        tmp.rmdir()
-    except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
-        raise
+        with OutDir(out, "odo-gap", force, inputs) as od:
+            d = rep.to_dict()
+            (od.tmp / "report.json").write_text(
+                json.dumps(d, indent=2, default=_json_default) + "\n"
+            )
+            (od.tmp / "report.md").write_text(markdown(d))
+            if rep.context is not None:
+                plot_report(d, rep.context, od.tmp)
+    except OutputError as e:
+        raise GapInputError(e.path, e.why) from None
 
 
 def _json_default(o):

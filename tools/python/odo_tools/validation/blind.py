@@ -28,8 +28,8 @@ import numpy as np
 from ..gap import catalog
 from ..gap.errors import GapInputError
 from ..gap.io import ID_LINEAR, ID_ROTARY, ID_WHEEL, encode_payload, source_dir, write_candump
-from ..gap.report import MANIFEST, manifest_text, read_manifest
 from ..gap.simlib import Event, Opts, Result, RowEx, lib
+from ..outpath import OutDir, OutputError
 
 BLIND_TOOL = "odo-gap blind"
 
@@ -392,29 +392,19 @@ def run_blind(
     workers: int,
     progress=None,
     worlds: tuple[str, ...] = ("sim",),
+    force: bool = False,
 ) -> dict:
     """Generate, diagnose and score `n_cases` per world. OUT/<world>/{keys/, scores.json,
     results.json, scores.png}, OUT/scores.json with every world. The whole of OUT (keys included)
-    is built in a fresh OUT.tmp.* folder, which the diagnosing workers may not open, and moved
-    into place under the output rule (gap/report.py): an absent or empty OUT, or one holding this
-    tool's manifest, whose listed entries alone are replaced; anything else is refused."""
+    is built in the output rule's fresh temp folder (odo_tools/outpath.py), which the diagnosing
+    workers may not open, and moved into place by that rule."""
     t0 = time.perf_counter()
-    out = Path(out)
-    names = ["scores.json", *worlds]
-    old: list[str] | None = None
-    if out.is_symlink() or (out.exists() and not out.is_dir()):
-        raise GapInputError(out, "exists and is not a folder: not replaced")
-    if out.is_dir() and any(out.iterdir()):
-        old = read_manifest(out, BLIND_TOOL)
-        if old is None:
-            raise GapInputError(out, "exists and is not an odo-gap blind output: not replaced")
-        for n in names:
-            if (out / n).exists() and n not in old:
-                raise GapInputError(out / n, "exists and odo-gap blind did not write it: "
-                                    "not replaced")
+    try:
+        od = OutDir(out, BLIND_TOOL, force)
+    except OutputError as e:
+        raise GapInputError(e.path, e.why) from None
+    tmp = od.tmp
     gens = {w: world(w) for w in worlds}
-    out.parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix=out.name + ".tmp.", dir=out.parent))
     data = Path(tempfile.mkdtemp(prefix="odo-gap-blind-"))  # case data: nowhere near the keys
     all_scores = {}
     try:
@@ -457,23 +447,12 @@ def run_blind(
         (tmp / "scores.json").write_text(
             json.dumps({"worlds": all_scores, "total_s": time.perf_counter() - t0}, indent=2) + "\n"
         )
-        (tmp / MANIFEST).write_text(manifest_text(BLIND_TOOL, names))
-        if old is None:
-            if out.is_dir():
-                out.rmdir()  # empty: nothing of anyone's is lost
-            tmp.rename(out)
-        else:
-            for n in set(old) | set(names):
-                p = out / n  # listed in this tool's manifest: written by it
-                if p.is_dir() and not p.is_symlink():
-                    shutil.rmtree(p)
-                elif p.exists() or p.is_symlink():
-                    p.unlink()
-            for n in [*names, MANIFEST]:
-                os.replace(tmp / n, out / n)
-            tmp.rmdir()
+        try:
+            od.commit()
+        except OutputError as e:
+            raise GapInputError(e.path, e.why) from None
     except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
+        od.abort()
         raise
     finally:
         shutil.rmtree(data, ignore_errors=True)
