@@ -53,6 +53,8 @@ def test_return_errors_name_tyre_scrub_and_shrink_fivefold(sessions, tmp_path: P
     assert h["mm_before"] / h["mm_after"] >= 5.0, h
     md = (tmp_path / "rep" / "report.md").read_text()
     assert "turn-radius-dependent wheelbase (tyre scrub)" in md and "scrub.k" in md
+    # the next step is a command odo-calib takes (its --help has these flags)
+    assert "odo-calib fit --runs " in md and " --free " in md and "--out-params" in md
     texts = [f["text"] for f in rep["stability"]["findings"]]
     assert any("tyre scrub" in t and "cannot tell" in t for t in texts), texts
 

@@ -356,7 +356,7 @@ def next_step(ds: Dataset, sel: Selection, verdict: str, best: Fit, findings: li
         )
         out.append(
             f"correct {words('+'.join(effects))} in the parameter block ({vals}): "
-            f"odo-calib fit --real {real} --robot {ds.robot_path} --effects "
+            f"odo-calib fit --runs {real} --robot {ds.robot_path} --free "
             f"{','.join(effects)} --out-params calibrated.json, then odo-calib write --image "
             "build/cm4/bin/odo_image.elf --params calibrated.json --out fw.elf"
         )
