@@ -195,6 +195,21 @@ def _module_name(pkg_root: Path, path: Path) -> str:
     return ".".join(parts)
 
 
+def _type_checking_nodes(tree: ast.AST) -> set[int]:
+    """ids of the nodes under `if TYPE_CHECKING:` (or `typing.TYPE_CHECKING`): imports that only
+    annotations use (the modules use `from __future__ import annotations`), never executed, so
+    they are no dependency at run time. Imports inside functions do count."""
+    out: set[int] = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.If):
+            t = node.test
+            name = t.id if isinstance(t, ast.Name) else t.attr if isinstance(t, ast.Attribute) else ""
+            if name == "TYPE_CHECKING":
+                for child in node.body:
+                    out.update(id(n) for n in ast.walk(child))
+    return out
+
+
 def py_graph(pkg_root: Path) -> dict[str, set[str]]:
     """{module: odo_tools modules it imports anywhere in its body} for the package at pkg_root."""
     files = {_module_name(pkg_root, p): p for p in sorted(pkg_root.rglob("*.py"))}
@@ -204,7 +219,10 @@ def py_graph(pkg_root: Path) -> dict[str, set[str]]:
         is_pkg = path.name == "__init__.py"
         deps = graph.setdefault(mod, set())
         tree = ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
+        typing_only = _type_checking_nodes(tree)
         for node in ast.walk(tree):
+            if id(node) in typing_only:
+                continue
             if isinstance(node, ast.Import):
                 for a in node.names:
                     name = a.name

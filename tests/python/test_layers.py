@@ -160,6 +160,36 @@ def test_python_cycles_count_imports_inside_functions(tmp_path: Path) -> None:
     ]
 
 
+def test_python_imports_for_annotations_only_are_no_dependency(tmp_path: Path) -> None:
+    """`if TYPE_CHECKING:` imports never run; an import inside a function beside them does."""
+    pkg = tmp_path / "odo_tools"
+    _write(
+        pkg,
+        {
+            "__init__.py": "",
+            "report.py": """\
+                from typing import TYPE_CHECKING
+                import typing
+                if TYPE_CHECKING:
+                    from .diagnose import Dataset
+                if typing.TYPE_CHECKING:
+                    from . import fit
+                def write():
+                    from .plots import plot
+                """,
+            "diagnose.py": "from .report import write\n",
+            "fit.py": "from . import report\n",
+            "plots.py": "if TYPE_CHECKING:\n    from .report import write\nelse:\n    from . import diagnose\n",
+        },
+    )
+    graph = layers.py_graph(pkg)
+    assert graph["odo_tools.report"] == {"odo_tools.plots"}
+    assert graph["odo_tools.plots"] == {"odo_tools.diagnose"}
+    assert layers.check_python(graph) == [
+        "import cycle: odo_tools.diagnose <-> odo_tools.plots <-> odo_tools.report"
+    ]
+
+
 def test_tarjan_finds_every_strongly_connected_component() -> None:
     g = {"a": {"b"}, "b": {"c"}, "c": {"a", "d"}, "d": {"e"}, "e": {"d"}, "f": {"f", "a"}}
     assert layers.cycles(g) == [["a", "b", "c"], ["d", "e"]]
