@@ -179,7 +179,12 @@ def test_python_imports_for_annotations_only_are_no_dependency(tmp_path: Path) -
                 """,
             "diagnose.py": "from .report import write\n",
             "fit.py": "from . import report\n",
-            "plots.py": "if TYPE_CHECKING:\n    from .report import write\nelse:\n    from . import diagnose\n",
+            "plots.py": """\
+                if TYPE_CHECKING:
+                    from .report import write
+                else:
+                    from . import diagnose
+                """,
         },
     )
     graph = layers.py_graph(pkg)
