@@ -1,7 +1,7 @@
 /// The effects catalog and the scenario JSON reader; see effects.h for the schema.
 #include "effects.h"
 
-#include "robot.h"
+#include "odo_robot.h"
 
 #include <errno.h>
 #include <jansson.h>

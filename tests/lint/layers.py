@@ -203,7 +203,11 @@ def _type_checking_nodes(tree: ast.AST) -> set[int]:
     for node in ast.walk(tree):
         if isinstance(node, ast.If):
             t = node.test
-            name = t.id if isinstance(t, ast.Name) else t.attr if isinstance(t, ast.Attribute) else ""
+            name = ""
+            if isinstance(t, ast.Name):
+                name = t.id
+            elif isinstance(t, ast.Attribute):
+                name = t.attr
             if name == "TYPE_CHECKING":
                 for child in node.body:
                     out.update(id(n) for n in ast.walk(child))
