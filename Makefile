@@ -4,7 +4,7 @@ SHELL := /bin/bash
 .DEFAULT_GOAL := help
 JOBS ?= $(shell nproc)
 
-.PHONY: help deps build release cm4 test demo bench bench-target soak flash flash-params flash-all clean
+.PHONY: help deps build release cm4 test demo bench bench-target soak flash flash-params flash-all package lock clean
 
 help: ## list targets
 	@grep -E '^[a-z0-9-]+:.*## ' $(MAKEFILE_LIST) | awk -F':.*## ' '{printf "  make %-12s %s\n", $$1, $$2}'
@@ -47,6 +47,13 @@ flash-all: cm4 ## program image and its default parameter block (erases a calibr
 
 soak: release ## frame loss at speed and the 24 h fault soak, JSON (build/release/bin/odo-soak --json)
 	@build/release/bin/odo-soak --json
+
+package: release ## the .deb (CPack, release build) and the wheel, in build/release/package
+	@cd build/release && cpack -G DEB -B package >/dev/null && ls package/*.deb
+	@bash tools/python/wheel.sh build/release/package
+
+lock: ## re-compile tools/python/requirements.txt (hash-pinned) from pyproject.toml; needs PyPI
+	@bash tools/python/lock.sh
 
 clean: ## remove build output (keeps .venv)
 	rm -rf build

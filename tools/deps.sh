@@ -14,6 +14,7 @@ APT_PACKAGES=(
   qemu-system-x86 busybox-static cpio can-utils                     # vcan test: Debian kernel under qemu
   qemu-system-arm                                                  # target tests: Cortex-M4 boards under qemu
   openocd                                                          # make flash; its config check in ctest
+  dpkg-dev help2man                                                # the .deb: CPack's shlibdeps, man pages
 )
 
 missing=()
@@ -27,7 +28,9 @@ if ((${#missing[@]})); then
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
 fi
 
-# Python venv from PyPI, pinned. Re-installed only when a requirements file changes.
+# Python venv from PyPI: every package (and what it pulls in) pinned with hashes in
+# tools/python/requirements.txt, compiled from pyproject.toml by tools/python/lock.sh.
+# Re-installed only when a requirements file changes.
 VENV=.venv
 PY=/usr/bin/python3
 [ -x "$PY" ] || PY=python3
@@ -37,12 +40,15 @@ want=$(for f in tools/python/requirements.txt tools/python/requirements-unity.tx
 if [ ! -x "$VENV/bin/python" ] || [ "$(cat "$stamp" 2>/dev/null)" != "$want" ]; then
   echo "deps: building $VENV from PyPI (pinned)"
   [ -x "$VENV/bin/python" ] || "$PY" -m venv "$VENV"
-  "$VENV/bin/pip" install -q --disable-pip-version-check -r tools/python/requirements.txt
+  "$VENV/bin/pip" install -q --disable-pip-version-check --require-hashes \
+    -r tools/python/requirements.txt
   # Unity's C sources (see cmake/Unity.cmake): no dependencies, hash-checked download.
   "$VENV/bin/pip" install -q --disable-pip-version-check --no-deps --require-hashes \
     -r tools/python/requirements-unity.txt
   if [ -f tools/python/pyproject.toml ]; then
-    "$VENV/bin/pip" install -q --disable-pip-version-check --no-deps -e tools/python
+    # setuptools and wheel come from the lock above, so the build needs no unpinned download
+    "$VENV/bin/pip" install -q --disable-pip-version-check --no-deps --no-build-isolation \
+      -e tools/python
   fi
   echo "$want" > "$stamp"
 fi

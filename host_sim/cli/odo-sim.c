@@ -15,6 +15,7 @@
 #include <unistd.h>
 
 #include "candump.h"
+#include "data_dir.h"
 #include "params_json.h"
 #include "effects.h"
 #include "odo/odo_can.h"
@@ -29,6 +30,7 @@ static void usage(FILE *f)
     fprintf(f,
             "usage: odo-sim --experiment NAME --vehicle labmate|clapper|set --scenario S.json --out DIR\n"
             "               [--robot R.json] [--runs N] [--bumps N] [--ipec on|off|paper|estimator] [--seed S] [--quiet]\n"
+            "               [--log-start now|SECONDS]\n"
             "       odo-sim --list-effects [--json]\n"
             "\n"
             "Experiments (000, 004): umbmark, umbmark-ext, straight-36m, rect-7x4. Closed paths run N\n"
@@ -37,6 +39,9 @@ static void usage(FILE *f)
             "Writes DIR/run-<dir>-NN.log (sensor frames, candump -l), DIR/run-<dir>-NN.truth.csv,\n"
             "DIR/returns.csv and DIR/summary.json. An existing DIR is replaced only if it holds a\n"
             "previous odo-sim output.\n"
+            "--log-start: the logs' first timestamp, whole seconds since the epoch (default\n"
+            "$SOURCE_DATE_EPOCH if set, else now; 0 for reproducible logs). The truth CSVs' t_s is\n"
+            "on the same clock.\n"
             "--params P.json|P.bin: run the firmware with this parameter block's calibration (Ed, Eb,\n"
             "Es per truck, e.g. from odo-calib umbmark --out-params); the world keeps the robot's true\n"
             "geometry, and the block's nominal geometry must match the robot description's.\n");
@@ -45,6 +50,7 @@ static void usage(FILE *f)
 typedef struct {
     FILE    *log;
     FILE    *truth;
+    uint64_t start_us; /* --log-start: added to every frame's time */
     unsigned trucks;
     int      io_error;
 } run_files_t;
@@ -60,18 +66,18 @@ static void write_sensor_frames(run_files_t *rf, const sim_tick_t *tk)
         const odo_msg_wheel_counts_t m = {in->wheel[t].left_raw, in->wheel[t].right_raw, in->wheel[t].seq,
                                           in->wheel[t].status};
         odo_can_pack_wheel_counts(t, &m, &f);
-        rf->io_error |= odo_candump_write(rf->log, in->t_us, "can0", &f);
+        rf->io_error |= odo_candump_write(rf->log, rf->start_us + in->t_us, "can0", &f);
     }
     if (in->link.rotary_present) {
         const odo_msg_link_rotary_t m = {in->link.alpha_bam16, in->link.beta_bam16, in->link.rotary_seq,
                                          in->link.rotary_status};
         odo_can_pack_link_rotary(&m, &f);
-        rf->io_error |= odo_candump_write(rf->log, in->t_us, "can0", &f);
+        rf->io_error |= odo_candump_write(rf->log, rf->start_us + in->t_us, "can0", &f);
     }
     if (in->link.linear_present) {
         const odo_msg_link_linear_t m = {in->link.length_um, in->link.linear_seq, in->link.linear_status};
         odo_can_pack_link_linear(&m, &f);
-        rf->io_error |= odo_candump_write(rf->log, in->t_us, "can0", &f);
+        rf->io_error |= odo_candump_write(rf->log, rf->start_us + in->t_us, "can0", &f);
     }
 }
 
@@ -80,7 +86,9 @@ static void on_tick(void *user, const sim_tick_t *tk)
     run_files_t *rf = user;
     write_sensor_frames(rf, tk);
     const double deg = 180.0 / M_PI;
-    fprintf(rf->truth, "%.3f,%.4f,%.4f,%.6f,%.4f,%.4f,%.6f,%.6f,%.6f,%.4f,", tk->t_s, tk->truth[0].x_mm,
+    /* on the log's clock: a whole-second start (--log-start) plus the run's time */
+    fprintf(rf->truth, "%.3f,%.4f,%.4f,%.6f,%.4f,%.4f,%.6f,%.6f,%.6f,%.4f,",
+            (double)(rf->start_us / 1000000U) + tk->t_s, tk->truth[0].x_mm,
             tk->truth[0].y_mm, tk->truth[0].theta_rad * deg, tk->truth[1].x_mm, tk->truth[1].y_mm,
             tk->truth[1].theta_rad * deg, tk->link.alpha_rad * deg, tk->link.beta_rad * deg,
             tk->link.length_mm);
@@ -201,6 +209,12 @@ int main(int argc, char **argv)
     int ipec = 0, quiet = 0, seed_given = 0, list_effects = 0, list_json = 0;
     uint64_t seed = 0;
     const char *params_path = NULL; /* --params: calibration for the firmware */
+    uint64_t log_start_us = 0U;     /* --log-start; else SOURCE_DATE_EPOCH, else the wall clock */
+    if (odo_log_start_default(&log_start_us) != 0) {
+        fprintf(stderr, "odo-sim: SOURCE_DATE_EPOCH must be whole seconds 0..%llu\n",
+                (unsigned long long)ODO_LOG_START_MAX_S);
+        return 2;
+    }
     for (int i = 1; i < argc; ++i) {
         const char *a = argv[i];
         const char *v = i + 1 < argc ? argv[i + 1] : NULL;
@@ -217,6 +231,12 @@ int main(int argc, char **argv)
         } else if (v == NULL) {
             fprintf(stderr, "odo-sim: %s needs a value (or is unknown)\n", a);
             return 2;
+        } else if (strcmp(a, "--log-start") == 0) {
+            if (odo_log_start_parse(argv[++i], &log_start_us) != 0) {
+                fprintf(stderr, "odo-sim: --log-start must be now or whole seconds 0..%llu, not '%s'\n",
+                        (unsigned long long)ODO_LOG_START_MAX_S, argv[i]);
+                return 2;
+            }
         } else if (strcmp(a, "--experiment") == 0) {
             experiment = argv[++i];
         } else if (strcmp(a, "--vehicle") == 0) {
@@ -288,15 +308,13 @@ int main(int argc, char **argv)
     char err[512];
     char default_robot[PATH_MAX];
     if (robot_path == NULL) {
-        /* The stock descriptions live beside the binary's source tree: build/<preset>/bin/.. */
-        char self[PATH_MAX - 64];
-        const ssize_t n = readlink("/proc/self/exe", self, sizeof self - 1);
-        self[n > 0 ? n : 0] = '\0';
-        char *slash = strrchr(self, '/');
-        if (slash != NULL) {
-            *slash = '\0';
+        /* The stock descriptions: the checkout's, or the installed ones (tools/lib/data_dir.h). */
+        char rel[96];
+        snprintf(rel, sizeof rel, "host_sim/robots/%s.json", vehicle_name);
+        if (odo_data_path(rel, default_robot, sizeof default_robot) != 0) {
+            fprintf(stderr, "odo-sim: the robot file's path is too long; give --robot\n");
+            return 1;
         }
-        snprintf(default_robot, sizeof default_robot, "%s/../../../host_sim/robots/%s.json", self, vehicle_name);
         robot_path = default_robot;
     }
     if (sim_robot_parse_file(robot_path, &robot, err, sizeof err) != 0) {
@@ -359,7 +377,7 @@ int main(int argc, char **argv)
         for (unsigned k = 0; k < (unsigned)runs && rc == 0; ++k) {
             const char *dname = straight ? "fwd" : (d ? "ccw" : "cw");
             char path[PATH_MAX];
-            run_files_t rf = {.trucks = robot.n_trucks};
+            run_files_t rf = {.trucks = robot.n_trucks, .start_us = log_start_us};
             snprintf(path, sizeof path, "%s/run-%s-%02u.log", tmp, dname, k + 1);
             rf.log = fopen(path, "w");
             snprintf(path, sizeof path, "%s/run-%s-%02u.truth.csv", tmp, dname, k + 1);

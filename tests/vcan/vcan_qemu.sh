@@ -41,9 +41,10 @@ done
 rm -rf "$W"
 mkdir -p "$W/data"
 
-# 1. The input: the first LOG_SECONDS of a clapper straight-36m run from the simulator.
+# 1. The input: the first LOG_SECONDS of a clapper straight-36m run from the simulator, on the
+#    fixed epoch 0 (the awk below cuts by time since the start).
 "$B/bin/odo-sim" --experiment straight-36m --vehicle clapper --scenario "$S/host_sim/scenarios/none.json" \
-    --runs 1 --quiet --out "$W/sim" >/dev/null
+    --runs 1 --quiet --log-start 0 --out "$W/sim" >/dev/null
 awk -v lim="$LOG_SECONDS" '{t = substr($1, 2, length($1) - 2) + 0; if (t < lim) print}' \
     "$W/sim/run-fwd-01.log" >"$W/data/in.log"
 cp "$S/host_sim/robots/clapper.json" "$W/data/robot.json"

@@ -71,7 +71,8 @@ static void on_tick(void *user, replay_t *r, uint64_t tick, const odo_tick_input
         odo_truck_step(&c->shadow, &r->app.model[0], in->wheel[0].left_raw, in->wheel[0].right_raw, in->wheel[0].bits,
                        skip == 0U ? 1U : skip, &st);
     }
-    run->t_s[run->n] = (double)tick * (double)r->tick_us * 1e-6;
+    /* on the log's clock (tick 0 at its first frame), the clock the truth CSV beside it uses */
+    run->t_s[run->n] = (double)r->origin_us * 1e-6 + (double)tick * (double)r->tick_us * 1e-6;
     run->delta[run->n][0] = st.delta[0];
     run->delta[run->n][1] = st.delta[1];
     run->n++;

@@ -11,7 +11,7 @@
 #include "sil.h"
 #include "summary.h"
 
-/// Source tree root ($ODO_SOURCE_DIR, else build/<preset>/bin/../../..).
+/// The data root: $ODO_SOURCE_DIR, the checkout, or PREFIX/share/odometry (tools/lib/data_dir.h).
 const char *ipec_src_dir(void);
 
 /// Robot (default host_sim/robots/<vehicle>.json) and scenario (NULL: no effects). 0 or -1 (printed).

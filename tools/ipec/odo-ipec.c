@@ -9,6 +9,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "data_dir.h"
 #include "ipec_tool.h"
 
 static void usage(FILE *f)
@@ -45,19 +46,7 @@ static char g_src[PATH_MAX - 256];
 const char *ipec_src_dir(void)
 {
     if (g_src[0] == '\0') {
-        const char *env = getenv("ODO_SOURCE_DIR");
-        if (env != NULL && env[0] != '\0') {
-            snprintf(g_src, sizeof g_src, "%s", env);
-        } else {
-            char self[PATH_MAX - 512];
-            const ssize_t n = readlink("/proc/self/exe", self, sizeof self - 1);
-            self[n > 0 ? n : 0] = '\0';
-            char *slash = strrchr(self, '/');
-            if (slash != NULL) {
-                *slash = '\0';
-            }
-            snprintf(g_src, sizeof g_src, "%s/../../..", self); /* build/<preset>/bin -> source */
-        }
+        (void)odo_data_path(".", g_src, sizeof g_src); /* "" if too long: paths then fail to open */
     }
     return g_src;
 }

@@ -17,6 +17,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
+from .plotstyle import LEGEND_PT, TITLE_PT, save_png
+
 
 def read_pose(path: Path) -> dict[str, np.ndarray]:
     """Columns of an odo-demo pose.csv as float arrays, keyed by header name."""
@@ -28,43 +30,71 @@ def read_pose(path: Path) -> dict[str, np.ndarray]:
     return {name: data[:, i] for i, name in enumerate(header)}
 
 
-def plot(runs: dict[str, Path], out: Path) -> None:
-    fig, (ax, zoom) = plt.subplots(1, 2, figsize=(12, 5.5))
+def figure(runs: dict[str, Path]) -> plt.Figure:
+    fig, (ax, zoom) = plt.subplots(1, 2, figsize=(11, 5.8), gridspec_kw={"width_ratios": [1, 1.3]})
     colours = {"cw": "tab:blue", "ccw": "tab:red"}
     errors: list[float] = []
     for name, path in runs.items():
         p = read_pose(path)
         c = colours.get(name, "k")
         ax.plot(p["x_mm"] / 1000, p["y_mm"] / 1000, "--", color=c, lw=1, label=f"{name}: firmware")
-        ax.plot(p["true_x_mm"] / 1000, p["true_y_mm"] / 1000, "-", color=c, lw=1.5,
-                label=f"{name}: true path")
+        ax.plot(
+            p["true_x_mm"] / 1000,
+            p["true_y_mm"] / 1000,
+            "-",
+            color=c,
+            lw=1.5,
+            label=f"{name}: true path",
+        )
         ex, ey = p["true_x_mm"][-1] - p["x_mm"][-1], p["true_y_mm"][-1] - p["y_mm"][-1]
-        zoom.plot([ex], [ey], "o", color=c, ms=9, label=f"{name}: ex {ex:.0f}, ey {ey:.0f} mm")
+        zoom.plot([0, ex], [0, ey], ":", color=c, lw=1)
+        zoom.plot(
+            [ex],
+            [ey],
+            "o",
+            color=c,
+            ms=9,
+            label=f"{name}: ex {ex:.0f}, ey {ey:.0f} mm (|e| {np.hypot(ex, ey):.0f} mm)",
+        )
         errors += [abs(ex), abs(ey)]
-    ax.set(xlabel="x [m]", ylabel="y [m]", title="4 x 4 m UMBmark square, uncalibrated robot",
-           aspect="equal")
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m]")
+    ax.set_title("4 x 4 m UMBmark square, uncalibrated robot", fontsize=TITLE_PT)
+    ax.set_aspect("equal")
     ax.grid(True, alpha=0.3)
-    ax.legend(fontsize=8)
+    # below the axes: inside, any corner covers a path
+    ax.legend(fontsize=LEGEND_PT, loc="upper center", bbox_to_anchor=(0.5, -0.1), ncol=2)
     zoom.axhline(0, color="grey", lw=0.5)
     zoom.axvline(0, color="grey", lw=0.5)
-    zoom.set(xlabel="ex [mm]", ylabel="ey [mm]", title="return position error (000 Eq. 3.1)",
-             aspect="equal")
+    zoom.plot(0, 0, "k+", ms=14)
+    zoom.set_xlabel("ex = x_true - x_firmware [mm]")
+    zoom.set_ylabel("ey = y_true - y_firmware [mm]")
+    zoom.set_title("return position error at the end (000 Eq. 3.1)", fontsize=TITLE_PT)
+    zoom.set_aspect("equal")
     lim = 1.3 * max([50.0, *errors])
     zoom.set_xlim(-lim, lim)
     zoom.set_ylim(-lim, lim)
     zoom.grid(True, alpha=0.3)
-    zoom.legend(fontsize=8)
+    zoom.legend(fontsize=LEGEND_PT, loc="lower left")
     fig.tight_layout()
+    return fig
+
+
+def plot(runs: dict[str, Path], out: Path) -> None:
     out.parent.mkdir(parents=True, exist_ok=True)
-    tmp = out.with_suffix(".tmp.png")
-    fig.savefig(tmp, dpi=110)
-    tmp.replace(out)
+    save_png(figure(runs), out)
 
 
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__)
-    ap.add_argument("--run", action="append", default=[], metavar="NAME=POSE_CSV", required=True,
-                    help="a run to draw, e.g. cw=out/demo/cw/pose.csv (repeatable)")
+    ap.add_argument(
+        "--run",
+        action="append",
+        default=[],
+        metavar="NAME=POSE_CSV",
+        required=True,
+        help="a run to draw, e.g. cw=out/demo/cw/pose.csv (repeatable)",
+    )
     ap.add_argument("--out", type=Path, required=True, help="PNG to write")
     args = ap.parse_args(argv)
     runs = {}

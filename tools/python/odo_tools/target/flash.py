@@ -36,6 +36,8 @@ from elftools.elf.constants import SH_FLAGS
 from elftools.elf.elffile import ELFFile
 from elftools.elf.sections import SymbolTableSection
 
+from ..resources import data_root
+
 MAGIC = b"ODOP"
 HEADER = 8  # magic, version (u16), length (u16): odo/odo_params.h
 
@@ -167,7 +169,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--image", type=Path, default=Path("build/cm4/bin/odo_image.elf"),
                     help="the built image (its linker symbols give every address)")
     ap.add_argument("--params", type=Path, help="params: odo-calib write output or a bare block")
-    ap.add_argument("--cfg", type=Path, default=Path("hal/cortexm/openocd/odo_stm32f4.cfg"))
+    ap.add_argument("--cfg", type=Path, default=data_root() / "hal/cortexm/openocd/odo_stm32f4.cfg",
+                    help="openocd configuration (default: the checkout's, or the installed one)")
     ap.add_argument("--dry-run", action="store_true",
                     help="print the openocd command and the file as JSON; program nothing")
     ap.add_argument("--keep", type=Path, help="write the programmed file here too")
