@@ -4,7 +4,7 @@ SHELL := /bin/bash
 .DEFAULT_GOAL := help
 JOBS ?= $(shell nproc)
 
-.PHONY: help deps build release cm4 test demo bench bench-target soak flash flash-params flash-all package lock clean
+.PHONY: help deps build release cm4 test demo bench bench-target soak fuzz coverage format flash flash-params flash-all package lock clean
 
 help: ## list targets
 	@grep -E '^[a-z0-9-]+:.*## ' $(MAKEFILE_LIST) | awk -F':.*## ' '{printf "  make %-12s %s\n", $$1, $$2}'
@@ -47,6 +47,21 @@ flash-all: cm4 ## program image and its default parameter block (erases a calibr
 
 soak: release ## frame loss at speed and the 24 h fault soak, JSON (build/release/bin/odo-soak --json)
 	@build/release/bin/odo-soak --json
+
+fuzz: deps ## long libFuzzer campaigns, 10^7 execs per harness (FUZZ_RUNS=N to change), JSON (fuzz/README.md)
+	@python3 fuzz/campaign.py --runs $(or $(FUZZ_RUNS),10000000)
+
+coverage: deps ## firmware/ line and branch coverage from the Unity tests (gcovr; build/coverage)
+	@cmake --preset coverage >/dev/null
+	@cmake --build --preset coverage -j $(JOBS) --target $(notdir $(basename $(wildcard tests/unit/test_*.c)))
+	@find build/coverage -name '*.gcda' -delete
+	@ctest --test-dir build/coverage -R '^unit[.]' -j $(JOBS) --output-on-failure >/dev/null
+	@gcovr --root . --filter 'firmware/' --exclude-unreachable-branches --print-summary \
+	  --txt build/coverage/coverage.txt build/coverage | tail -n 3
+	@echo "per file: build/coverage/coverage.txt"
+
+format: ## reformat every C file by .clang-format (the folders: tests/lint/clang_format.py); ctest lint.format checks it
+	@python3 tests/lint/clang_format.py . --fix
 
 package: release ## the .deb (CPack, release build) and the wheel, in build/release/package
 	@cd build/release && cpack -G DEB -B package >/dev/null && ls package/*.deb

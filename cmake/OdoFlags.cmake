@@ -11,10 +11,19 @@ function(odo_firmware_flags target)
     "SHELL:-include ${CMAKE_SOURCE_DIR}/firmware/src/odo_fw.h")
 endfunction()
 
+# The strict set (libcanard's) for host C too (hal/, hostlib/, host_sim/, tools/,
+# tests/): every host target gets it through odo_host_flags or its perf twin.
+set(ODO_STRICT_WARNINGS
+  -Wconversion -Wsign-conversion -Wdouble-promotion -Wswitch-enum -Wundef -Wcast-align)
+
+function(odo_strict_flags target)
+  target_compile_options(${target} PRIVATE ${ODO_STRICT_WARNINGS})
+endfunction()
+
 # Host C (tools, HAL backends, tests): warnings as errors, C99 with POSIX.1-2008/XSI (M_PI,
 # rename, fsync, clock_gettime).
 function(odo_host_flags target)
-  target_compile_options(${target} PRIVATE -Wall -Wextra -Wshadow -Werror)
+  target_compile_options(${target} PRIVATE -Wall -Wextra -Wshadow -Werror ${ODO_STRICT_WARNINGS})
   target_compile_definitions(${target} PRIVATE _XOPEN_SOURCE=700)
   odo_sanitize(${target})
 endfunction()

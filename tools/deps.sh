@@ -12,6 +12,8 @@ APT_PACKAGES=(
   libjansson-dev                                                   # host_sim robot/scenario JSON
   libgsl-dev                                                       # odo-calib fit: nonlinear least squares
   qemu-system-x86 busybox-static cpio can-utils                     # vcan test: Debian kernel under qemu
+  clang libclang-rt-14-dev                                         # fuzz/: libFuzzer harnesses
+  cppcheck clang-tidy clang-format gcovr                           # static analysis, format check, coverage
   qemu-system-arm                                                  # target tests: Cortex-M4 boards under qemu
   openocd                                                          # make flash; its config check in ctest
   dpkg-dev help2man                                                # the .deb: CPack's shlibdeps, man pages

@@ -140,8 +140,8 @@ static inline int32_t xy_10um(int64_t v_mm_q32, bool *sat)
 
 /// A truck's POSE_XY and POSE_THETA frames into f[0..1]. A position beyond POSE_XY's range is
 /// sent saturated and flagged (the truck's flags and, through *faults, STATUS).
-static void publish_truck(const odo_pose_t *pose, uint8_t truck, uint8_t seq, uint8_t flags,
-                          uint32_t *faults, odo_can_frame_t *f)
+static void publish_truck(const odo_pose_t *pose, uint8_t truck, uint8_t seq, uint8_t flags, uint32_t *faults,
+                          odo_can_frame_t *f)
 {
     bool sat = false;
     const odo_msg_pose_xy_t xy = {xy_10um(pose->x_mm_q32, &sat), xy_10um(pose->y_mm_q32, &sat)};
@@ -170,8 +170,8 @@ static void publish_status(const odo_app_t *app, uint32_t faults, odo_can_frame_
 
 /// Linkage check and, with IPEC on, the correction of both trucks (odo_ipec.h). Returns faults.
 /// With IPEC off only the check runs (its faults are reported); the reading is not decoded.
-static uint32_t ipec_tick(odo_app_t *app, const odo_tick_input_t *in, bool dr_ok,
-                          uint8_t pose_flags[ODO_TRUCKS], odo_tick_output_t *out)
+static uint32_t ipec_tick(odo_app_t *app, const odo_tick_input_t *in, bool dr_ok, uint8_t pose_flags[ODO_TRUCKS],
+                          odo_tick_output_t *out)
 {
     if (app->params.ipec_mode == (uint8_t)ODO_IPEC_OFF) {
         return odo_ipec_check(&app->ipec, &app->params, &in->link, NULL);
@@ -204,8 +204,8 @@ static uint32_t ipec_tick(odo_app_t *app, const odo_tick_input_t *in, bool dr_ok
 /// One truck's wheel sample: presence, decoder and sequence checks, then odometry over the ticks
 /// elapsed (odo_truck_tick). Writes this tick's dist_mm_q40/dturn_q64 of the truck, ORs its
 /// faults into *faults and returns its pose flags.
-static uint8_t truck_tick(odo_app_t *app, uint8_t i, const odo_wheel_input_t *w, uint64_t t_us,
-                          uint32_t *faults, odo_tick_output_t *out)
+static uint8_t truck_tick(odo_app_t *app, uint8_t i, const odo_wheel_input_t *w, uint64_t t_us, uint32_t *faults,
+                          odo_tick_output_t *out)
 {
     uint32_t f = 0U;
     uint8_t flags = 0U;
@@ -216,8 +216,8 @@ static uint8_t truck_tick(odo_app_t *app, uint8_t i, const odo_wheel_input_t *w,
         flags = ODO_POSE_FLAG_MISSING;
         r = odo_pose_in_range(&app->truck[i].pose) ? 0U : ODO_STEP_RANGE;
     } else {
-        if ((w->status & (ODO_WHEEL_STATUS_LEFT_SKIPPED | ODO_WHEEL_STATUS_RIGHT_SKIPPED |
-                          ODO_WHEEL_STATUS_LEFT_FAULT | ODO_WHEEL_STATUS_RIGHT_FAULT)) != 0U) {
+        if ((w->status & (ODO_WHEEL_STATUS_LEFT_SKIPPED | ODO_WHEEL_STATUS_RIGHT_SKIPPED | ODO_WHEEL_STATUS_LEFT_FAULT |
+                          ODO_WHEEL_STATUS_RIGHT_FAULT)) != 0U) {
             f = FAULT_DECODER[i];
         }
         uint32_t ticks = 1U;

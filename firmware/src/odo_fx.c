@@ -3,7 +3,7 @@
 /// (UMULL) and on a 64-bit host, and never relies on a compiler's __int128.
 #include "odo/odo_fx.h"
 
-#define LO32(v) ((v) & 0xFFFFFFFFULL)
+#define LO32(v) ((v)&0xFFFFFFFFULL)
 
 odo_u128_t odo_mul_u64(uint64_t a, uint64_t b)
 {
@@ -52,10 +52,7 @@ bool odo_muldiv_u64(uint64_t a, uint64_t b, uint64_t d, uint64_t *out)
 }
 
 /// Magnitude of a signed value as unsigned; exact for INT64_MIN.
-static uint64_t mag_s64(int64_t v)
-{
-    return v < 0 ? (uint64_t)0U - (uint64_t)v : (uint64_t)v;
-}
+static uint64_t mag_s64(int64_t v) { return v < 0 ? (uint64_t)0U - (uint64_t)v : (uint64_t)v; }
 
 /// Apply a sign to a magnitude known to fit (mag <= 2^63, and 2^63 only when negative).
 static int64_t apply_sign(uint64_t mag, bool negative)
@@ -94,8 +91,7 @@ static int64_t shr96_round_sat(uint64_t hi, uint64_t lo, unsigned shift, bool ne
         /* The half unit sits in hi (or is lo's top bit); lo's other bits cannot carry into the
          * result: floor((H + f) / 2^s) == floor(H / 2^s) for an integer H and 0 <= f < 1. */
         const unsigned s = shift - 64U;
-        return apply_sign_sat(0U, (s == 0U) ? hi + (lo >> 63) : (hi + ((uint64_t)1U << (s - 1U))) >> s,
-                              negative);
+        return apply_sign_sat(0U, (s == 0U) ? hi + (lo >> 63) : (hi + ((uint64_t)1U << (s - 1U))) >> s, negative);
     }
     return 0; /* p < 2^95: below half a unit */
 }

@@ -10,20 +10,11 @@
 
 /// nm -> mm Q32 for |nm| < 2^43 (8.8e12 nm, far beyond any link or wheelbase): the inline
 /// product, exact and without the saturation of odo_ipec_nm_to_mm_q32.
-static inline int64_t nm_to_mm_q32(int64_t nm)
-{
-    return odo_mul_s64_s32_rnd(nm, (int32_t)NM_TO_MM_Q32_K18, 18U);
-}
+static inline int64_t nm_to_mm_q32(int64_t nm) { return odo_mul_s64_s32_rnd(nm, (int32_t)NM_TO_MM_Q32_K18, 18U); }
 
-int64_t odo_ipec_nm_to_mm_q32(int64_t nm)
-{
-    return odo_mul_s64_s32_shr(nm, (int32_t)NM_TO_MM_Q32_K18, 18U);
-}
+int64_t odo_ipec_nm_to_mm_q32(int64_t nm) { return odo_mul_s64_s32_shr(nm, (int32_t)NM_TO_MM_Q32_K18, 18U); }
 
-void odo_ipec_init(odo_ipec_t *s)
-{
-    memset(s, 0, sizeof *s);
-}
+void odo_ipec_init(odo_ipec_t *s) { memset(s, 0, sizeof *s); }
 
 static uint32_t abs_diff_bam16(uint16_t a, uint16_t b)
 {
@@ -32,10 +23,7 @@ static uint32_t abs_diff_bam16(uint16_t a, uint16_t b)
 }
 
 /// Half a rotary step, in BAM.
-static uint32_t half_step_bam(uint8_t rotary_bits)
-{
-    return 1UL << (31U - rotary_bits);
-}
+static uint32_t half_step_bam(uint8_t rotary_bits) { return 1UL << (31U - rotary_bits); }
 
 static int32_t decode_angle(uint16_t code_bam16, int32_t bias_bam, uint8_t rotary_bits)
 {
@@ -43,16 +31,15 @@ static int32_t decode_angle(uint16_t code_bam16, int32_t bias_bam, uint8_t rotar
     return (int32_t)(((uint32_t)code_bam16 << 16) + half_step_bam(rotary_bits) - (uint32_t)bias_bam);
 }
 
-uint32_t odo_ipec_check(odo_ipec_t *s, const odo_params_t *p, const odo_link_input_t *in,
-                        odo_ipec_reading_t *rd)
+uint32_t odo_ipec_check(odo_ipec_t *s, const odo_params_t *p, const odo_link_input_t *in, odo_ipec_reading_t *rd)
 {
     const odo_link_params_t *lp = &p->link;
     const bool clapper = p->vehicle == (uint8_t)ODO_VEHICLE_CLAPPER;
     if (s->age_ticks != UINT32_MAX) {
         s->age_ticks++;
     }
-    const uint8_t need_rot = (uint8_t)(clapper ? (ODO_LINK_STATUS_ALPHA_VALID | ODO_LINK_STATUS_BETA_VALID)
-                                               : ODO_LINK_STATUS_ALPHA_VALID);
+    const uint8_t need_rot =
+        (uint8_t)(clapper ? (ODO_LINK_STATUS_ALPHA_VALID | ODO_LINK_STATUS_BETA_VALID) : ODO_LINK_STATUS_ALPHA_VALID);
     const bool rot_ok = in->rotary_present && (in->rotary_status & need_rot) == need_rot;
     const bool lin_ok = !clapper || (in->linear_present && (in->linear_status & ODO_LINK_STATUS_LENGTH_VALID) != 0U);
     if (!rot_ok || !lin_ok) {
@@ -82,8 +69,8 @@ uint32_t odo_ipec_check(odo_ipec_t *s, const odo_params_t *p, const odo_link_inp
     if (s->have_last && !stale) {
         const uint64_t max_a = (uint64_t)lp->max_jump_bam * ticks;
         const uint64_t max_l = (uint64_t)lp->max_length_jump_um * ticks;
-        const uint32_t dl_um = in->length_um > s->last_length_um ? in->length_um - s->last_length_um
-                                                                 : s->last_length_um - in->length_um;
+        const uint32_t dl_um =
+            in->length_um > s->last_length_um ? in->length_um - s->last_length_um : s->last_length_um - in->length_um;
         if (abs_diff_bam16(in->alpha_bam16, s->last_alpha_bam16) > max_a ||
             (clapper && (abs_diff_bam16(in->beta_bam16, s->last_beta_bam16) > max_a || dl_um > max_l))) {
             return ODO_FAULT_LINK_JUMP;
@@ -113,8 +100,8 @@ uint32_t odo_ipec_check(odo_ipec_t *s, const odo_params_t *p, const odo_link_inp
          * with |ecc| <= 5e7 nm stays below 2^57. No eccentricity: no cosine. */
         int64_t ecc_nm = 0;
         if (lp->length_ecc_nm != 0) {
-            const int64_t one_minus_cos_q30 = (int64_t)ODO_Q30_ONE -
-                                              odo_cos_q30((uint32_t)rd->alpha_bam - (uint32_t)rd->beta_bam);
+            const int64_t one_minus_cos_q30 =
+                (int64_t)ODO_Q30_ONE - odo_cos_q30((uint32_t)rd->alpha_bam - (uint32_t)rd->beta_bam);
             ecc_nm = odo_mul_s64_s32_rnd(one_minus_cos_q30, lp->length_ecc_nm, 30U);
         }
         const int64_t l_nm = (int64_t)in->length_um * 1000 - lp->length_bias_nm - ecc_nm;
@@ -132,10 +119,7 @@ uint32_t odo_ipec_link_heading_bam(const odo_pose_t *a, const odo_pose_t *b)
 }
 
 /// Heading as BAM, rounded (odo_heading_bam, inline).
-static inline uint32_t heading_bam(const odo_pose_t *p)
-{
-    return (uint32_t)((p->heading_q64 + 0x80000000ULL) >> 32);
-}
+static inline uint32_t heading_bam(const odo_pose_t *p) { return (uint32_t)((p->heading_q64 + 0x80000000ULL) >> 32); }
 
 /// Eq. 16's placement: *b at l (|l| < 2^61 mm Q32 / 2^30... any link: below 2^47) from *a against
 /// theta; two inline 64x32 products.
@@ -153,10 +137,7 @@ static inline void hitch(const odo_pose_t *a, uint32_t hitch_offset_nm, odo_pose
     h->heading_q64 = a->heading_q64;
 }
 
-void odo_ipec_hitch(const odo_pose_t *a, uint32_t hitch_offset_nm, odo_pose_t *h)
-{
-    hitch(a, hitch_offset_nm, h);
-}
+void odo_ipec_hitch(const odo_pose_t *a, uint32_t hitch_offset_nm, odo_pose_t *h) { hitch(a, hitch_offset_nm, h); }
 
 void odo_ipec_anchor(const odo_pose_t *a, uint32_t theta_l_bam, int64_t length_mm_q32, odo_pose_t *b)
 {
@@ -184,8 +165,8 @@ static int32_t abs_sin_half_q30(int32_t h_bam)
     return (int32_t)((sx + 2U) >> 2);
 }
 
-void odo_ipec_translate(odo_pose_t *p, int32_t dtheta_bam, int64_t dist_mm_q40,
-                        uint32_t wheelbase_nm, int64_t *dx_mm_q32, int64_t *dy_mm_q32)
+void odo_ipec_translate(odo_pose_t *p, int32_t dtheta_bam, int64_t dist_mm_q40, uint32_t wheelbase_nm,
+                        int64_t *dx_mm_q32, int64_t *dy_mm_q32)
 {
     int64_t dx = 0, dy = 0;
     if (dist_mm_q40 != 0 && dtheta_bam != 0) {
@@ -212,10 +193,7 @@ void odo_ipec_translate(odo_pose_t *p, int32_t dtheta_bam, int64_t dist_mm_q40,
     }
 }
 
-static int32_t clamp_s32(int32_t v, int32_t lim)
-{
-    return v > lim ? lim : (v < -lim ? -lim : v);
-}
+static int32_t clamp_s32(int32_t v, int32_t lim) { return v > lim ? lim : (v < -lim ? -lim : v); }
 
 int32_t odo_ipec_gain(uint8_t ipec_mode, int32_t innov_bam, uint8_t rotary_bits)
 {
@@ -234,10 +212,7 @@ int32_t odo_ipec_gain(uint8_t ipec_mode, int32_t innov_bam, uint8_t rotary_bits)
     return (innov_bam - inside) + (inside < 0 ? -pull : pull);
 }
 
-static uint64_t turns_q64(int32_t bam)
-{
-    return (uint64_t)((int64_t)bam * 4294967296LL);
-}
+static uint64_t turns_q64(int32_t bam) { return (uint64_t)((int64_t)bam * 4294967296LL); }
 
 /// Set: the correction divided by the joint's sensitivity, d L / den for den in [L/4, L + hitch]
 /// (both below 2^33 nm): L / den as a Q30 factor from 32-bit divisions only (no 64-bit division
@@ -253,7 +228,7 @@ static int32_t divide_sensitivity(int32_t d_bam, int64_t len_nm, int64_t den_nm)
         q = (q + 1U) >> 1;
     }
     const uint32_t l32 = (uint32_t)l, q32 = (uint32_t)q;
-    const uint32_t whole = l32 / q32;                /* 0..4 */
+    const uint32_t whole = l32 / q32; /* 0..4 */
     const uint32_t frac = odo_frac_q32(l32 - whole * q32, q32);
     /* factor in Q30: whole 2^30 + frac / 4 (rounded), at most 4 2^30 + 2^30 */
     const int64_t factor_q30 = ((int64_t)whole << 30) + (int64_t)((frac + 2U) >> 2);
@@ -261,8 +236,8 @@ static int32_t divide_sensitivity(int32_t d_bam, int64_t len_nm, int64_t den_nm)
     return r > INT32_MAX ? INT32_MAX : (r < INT32_MIN ? INT32_MIN : (int32_t)r);
 }
 
-void odo_ipec_step(const odo_params_t *p, const odo_ipec_reading_t *rd, odo_pose_t pose[2],
-                   int64_t dist_mm_q40, odo_ipec_result_t *out)
+void odo_ipec_step(const odo_params_t *p, const odo_ipec_reading_t *rd, odo_pose_t pose[2], int64_t dist_mm_q40,
+                   odo_ipec_result_t *out)
 {
     const bool set = p->vehicle == (uint8_t)ODO_VEHICLE_SET;
     odo_pose_t front = pose[0];
@@ -283,8 +258,8 @@ void odo_ipec_step(const odo_params_t *p, const odo_ipec_reading_t *rd, odo_pose
          * by d hitch cos(alpha) / L the other way: alpha moves by d (1 + hitch cos(alpha) / L).
          * Divide that sensitivity out (|alpha| < 90 deg keeps it above 1). */
         const int64_t len_nm = (int64_t)p->link.length_nm;
-        int64_t den = len_nm + odo_mul_s64_s32_rnd((int64_t)p->link.hitch_offset_nm,
-                                                   odo_cos_q30((uint32_t)rd->alpha_bam), 30U);
+        int64_t den =
+            len_nm + odo_mul_s64_s32_rnd((int64_t)p->link.hitch_offset_nm, odo_cos_q30((uint32_t)rd->alpha_bam), 30U);
         den = den < len_nm / 4 ? len_nm / 4 : den;
         out->dtheta_bam[0] = divide_sensitivity(out->dtheta_bam[0], len_nm, den);
     } else {
@@ -295,8 +270,7 @@ void odo_ipec_step(const odo_params_t *p, const odo_ipec_reading_t *rd, odo_pose
     const int32_t h = (int32_t)half_step_bam(p->link.rotary_bits);
     const int32_t fast = out->dtheta_bam[0] - clamp_s32(out->dtheta_bam[0], h);
     const uint64_t b_nm = ((uint64_t)p->truck[0].wheelbase_nm * (uint64_t)(uint32_t)p->truck[0].eb_q30) >> 30;
-    odo_ipec_translate(&pose[0], fast, dist_mm_q40, (uint32_t)b_nm, &out->shift_mm_q32[0],
-                       &out->shift_mm_q32[1]);
+    odo_ipec_translate(&pose[0], fast, dist_mm_q40, (uint32_t)b_nm, &out->shift_mm_q32[0], &out->shift_mm_q32[1]);
 
     /* Eq. 13. */
     pose[0].heading_q64 += turns_q64(out->dtheta_bam[0]);

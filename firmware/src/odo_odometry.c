@@ -9,9 +9,9 @@
 #define PI_Q60      3622009729038561421ULL
 #define INV_2PI_Q64 2935890503282001226ULL
 
-#define Q30_ONE_U ((uint64_t)1U << 30)
+#define Q30_ONE_U     ((uint64_t)1U << 30)
 #define SCRUB_MAX_Q30 ((int32_t)ODO_SCRUB_MAX_Q30)
-#define NM_PER_MM 1000000U
+#define NM_PER_MM     1000000U
 
 /* Heading bookkeeping reads a per-tick heading change as a signed fraction of a turn, which is
  * unambiguous only below half a turn: keep each wheel's worst case below a quarter. */
@@ -23,16 +23,14 @@
 static uint64_t q60_to_q40(uint64_t v) { return (v >> 20) + ((v >> 19) & 1U); }
 
 odo_model_status_t odo_model_init(odo_model_t *m, const odo_truck_params_t *tp, uint8_t counter_bits,
-                                  uint8_t heading_form, uint32_t tick_us,
-                                  uint32_t max_wheel_speed_mm_s)
+                                  uint8_t heading_form, uint32_t tick_us, uint32_t max_wheel_speed_mm_s)
 {
     const uint64_t ed = (uint64_t)(uint32_t)tp->ed_q30;
     const uint64_t eb = (uint64_t)(uint32_t)tp->eb_q30;
     const uint64_t es = (uint64_t)(uint32_t)tp->es_q30;
     if (tp->ed_q30 <= 0 || tp->eb_q30 <= 0 || tp->es_q30 <= 0 || tp->wheelbase_nm == 0U ||
-        tp->counts_per_rev_milli == 0U || counter_bits < ODO_COUNTER_BITS_MIN ||
-        counter_bits > ODO_COUNTER_BITS_MAX || tp->scrub_q30 < -SCRUB_MAX_Q30 ||
-        tp->scrub_q30 > SCRUB_MAX_Q30) {
+        tp->counts_per_rev_milli == 0U || counter_bits < ODO_COUNTER_BITS_MIN || counter_bits > ODO_COUNTER_BITS_MAX ||
+        tp->scrub_q30 < -SCRUB_MAX_Q30 || tp->scrub_q30 > SCRUB_MAX_Q30) {
         return ODO_MODEL_ERR_RANGE;
     }
 
@@ -76,10 +74,9 @@ odo_model_status_t odo_model_init(odo_model_t *m, const odo_truck_params_t *tp, 
     if (max_wheel_speed_mm_s > 4000000U) {
         return ODO_MODEL_ERR_RANGE;
     }
-    const uint64_t d_um = (uint64_t)max_wheel_speed_mm_s * (tick_us / 1000U) +
-                          (max_wheel_speed_mm_s * (tick_us % 1000U) + 999U) / 1000U;
-    const uint64_t k_min = (uint64_t)(mm.dist_mm_q40[0] < mm.dist_mm_q40[1] ? mm.dist_mm_q40[0]
-                                                                            : mm.dist_mm_q40[1]);
+    const uint64_t d_um =
+        (uint64_t)max_wheel_speed_mm_s * (tick_us / 1000U) + (max_wheel_speed_mm_s * (tick_us % 1000U) + 999U) / 1000U;
+    const uint64_t k_min = (uint64_t)(mm.dist_mm_q40[0] < mm.dist_mm_q40[1] ? mm.dist_mm_q40[0] : mm.dist_mm_q40[1]);
     uint64_t max_counts;
     if (!odo_muldiv_u64(d_um, (uint64_t)1U << 40, 1000U * k_min, &max_counts)) {
         return ODO_MODEL_ERR_RANGE;
@@ -151,8 +148,7 @@ static inline bool in_range(const odo_pose_t *p)
 /// constant-curvature arc (second-order accurate).
 static inline uint32_t step_direction_bam(const odo_pose_t *p, int64_t dturn_q64, uint8_t heading_form)
 {
-    const int64_t part = (heading_form == (uint8_t)ODO_HEADING_PAPER) ? dturn_q64
-                                                                       : odo_floor_shr_s64(dturn_q64, 1U);
+    const int64_t part = (heading_form == (uint8_t)ODO_HEADING_PAPER) ? dturn_q64 : odo_floor_shr_s64(dturn_q64, 1U);
     return (uint32_t)((p->heading_q64 + (uint64_t)part + 0x80000000ULL) >> 32);
 }
 
@@ -169,9 +165,8 @@ static inline void move(odo_pose_t *p, int64_t dist_mm_q40, int64_t dturn_q64, i
 /// of one tick stays in 32-bit arithmetic up to the products of 000 Eqs. 2.2-2.4: two 64x32 each
 /// for distance and heading. Writes *dist, *dturn and d[] (0 when nothing was integrated) and
 /// returns ODO_STEP_* bits.
-static inline uint32_t step(odo_truck_t *t, const odo_model_t *m, uint32_t left_raw, uint32_t right_raw,
-                            uint8_t bits, uint32_t ticks, int64_t *dist_out, int64_t *dturn_out,
-                            int32_t d_out[2])
+static inline uint32_t step(odo_truck_t *t, const odo_model_t *m, uint32_t left_raw, uint32_t right_raw, uint8_t bits,
+                            uint32_t ticks, int64_t *dist_out, int64_t *dturn_out, int32_t d_out[2])
 {
     const uint8_t w_bits = bits < m->counter_bits ? bits : m->counter_bits;
     *dist_out = 0;
@@ -221,8 +216,7 @@ static inline uint32_t step(odo_truck_t *t, const odo_model_t *m, uint32_t left_
     const int64_t dist = odo_floor_shr_s64(m->dist_mm_q40[0] * d_l + m->dist_mm_q40[1] * d_r + 1, 1U);
     /* Eq. 2.4 in turns: modular arithmetic on uint64 is exact whatever the size of d; read as a
      * signed change it is below a quarter turn per tick elapsed (checked at init). */
-    int64_t dturn = odo_as_s64(m->turn_q64[1] * (uint64_t)(int64_t)d_r -
-                               m->turn_q64[0] * (uint64_t)(int64_t)d_l);
+    int64_t dturn = odo_as_s64(m->turn_q64[1] * (uint64_t)(int64_t)d_r - m->turn_q64[0] * (uint64_t)(int64_t)d_l);
     if (m->scrub_q30 != 0) {
         /* g = 1 - k m / v, |k m / v| <= 1/4; modulo a turn, as a gap's dturn may be near half a
          * turn already. */
@@ -266,10 +260,10 @@ int32_t odo_sinc_half_q30(int64_t dturn_q64)
 {
     /* x in rad Q30 = pi * dturn / 2^64 * 2^30 = dturn * (pi * 2^29) / 2^63; |x| < pi/2 */
     const int64_t x = odo_mul_s64_s32_shr(dturn_q64, 1686629713, 63U);
-    const int64_t x2 = (x * x) >> 30; /* x^2 in Q30, < 2.65e9 */
-    int64_t p = ODO_Q30_ONE - ((x2 * 25565282) >> 30);             /* 1 - x^2/42 */
-    p = ODO_Q30_ONE - ((((x2 * p) >> 30) * 53687091) >> 30);       /* 1 - x^2/20 (...) */
-    p = ODO_Q30_ONE - ((((x2 * p) >> 30) * 178956971) >> 30);      /* 1 - x^2/6 (...) */
+    const int64_t x2 = (x * x) >> 30;                         /* x^2 in Q30, < 2.65e9 */
+    int64_t p = ODO_Q30_ONE - ((x2 * 25565282) >> 30);        /* 1 - x^2/42 */
+    p = ODO_Q30_ONE - ((((x2 * p) >> 30) * 53687091) >> 30);  /* 1 - x^2/20 (...) */
+    p = ODO_Q30_ONE - ((((x2 * p) >> 30) * 178956971) >> 30); /* 1 - x^2/6 (...) */
     return (int32_t)p;
 }
 
@@ -283,8 +277,8 @@ int64_t odo_scrub_dturn(const odo_model_t *m, int32_t d_left, int32_t d_right)
     const uint32_t v = a + b;                 /* < 2^32: |d| <= max_delta_counts < 2^31 */
     const uint32_t mv = 2U * (a < b ? a : b); /* <= v */
     /* k * dtheta from the k-scaled multipliers, with the same exact modular sum as Eq. 2.4. */
-    const int64_t k_dturn = odo_as_s64(m->scrub_turn_q64[1] * (uint64_t)(int64_t)d[1] -
-                                       m->scrub_turn_q64[0] * (uint64_t)(int64_t)d[0]);
+    const int64_t k_dturn =
+        odo_as_s64(m->scrub_turn_q64[1] * (uint64_t)(int64_t)d[1] - m->scrub_turn_q64[0] * (uint64_t)(int64_t)d[0]);
     if (mv == v) {
         return k_dturn; /* equal wheels: m / v = 1 (does not fit Q32) */
     }
@@ -298,11 +292,10 @@ uint32_t odo_truck_tick(odo_truck_t *t, const odo_model_t *m, const odo_wheel_in
     return step(t, m, w->left_raw, w->right_raw, w->bits, ticks, &motion[0], &motion[1], d);
 }
 
-void odo_truck_step(odo_truck_t *t, const odo_model_t *m, uint32_t left_raw, uint32_t right_raw,
-                    uint8_t bits, uint32_t ticks, odo_step_t *out)
+void odo_truck_step(odo_truck_t *t, const odo_model_t *m, uint32_t left_raw, uint32_t right_raw, uint8_t bits,
+                    uint32_t ticks, odo_step_t *out)
 {
-    const uint32_t r = step(t, m, left_raw, right_raw, bits, ticks, &out->dist_mm_q40, &out->dturn_q64,
-                            out->delta);
+    const uint32_t r = step(t, m, left_raw, right_raw, bits, ticks, &out->dist_mm_q40, &out->dturn_q64, out->delta);
     out->jump = (r & ODO_STEP_JUMP) != 0U;
     out->range = (r & ODO_STEP_RANGE) != 0U;
 }
@@ -314,10 +307,7 @@ void odo_pose_advance(odo_pose_t *p, int64_t dist_mm_q40, int64_t dturn_q64, uin
     move(p, dist_mm_q40, dturn_q64, s, c);
 }
 
-uint32_t odo_heading_bam(const odo_pose_t *p)
-{
-    return (uint32_t)((p->heading_q64 + 0x80000000ULL) >> 32);
-}
+uint32_t odo_heading_bam(const odo_pose_t *p) { return (uint32_t)((p->heading_q64 + 0x80000000ULL) >> 32); }
 
 int32_t odo_mm_q32_to_10um(int64_t v_mm_q32, bool *saturated)
 {

@@ -17,33 +17,43 @@
 #define WIDTH_U32 4U
 #define WIDTH_I32 4U
 
-#define MEMBER_OFF_TOP(m)   offsetof(odo_params_t, m)
-#define MEMBER_OFF_LINK(m)  offsetof(odo_params_t, m)
-#define MEMBER_OFF_TRUCK(m) offsetof(odo_truck_params_t, m)
+#define MEMBER_OFF_TOP(m)    offsetof(odo_params_t, m)
+#define MEMBER_OFF_LINK(m)   offsetof(odo_params_t, m)
+#define MEMBER_OFF_TRUCK(m)  offsetof(odo_truck_params_t, m)
 #define MEMBER_SIZE_TOP(m)   sizeof(((const odo_params_t *)0)->m)
 #define MEMBER_SIZE_LINK(m)  sizeof(((const odo_params_t *)0)->m)
 #define MEMBER_SIZE_TRUCK(m) sizeof(((const odo_truck_params_t *)0)->m)
 
-#define FIELD_ROW(id, scope, member, json, since, off, stride, type, lo, hi, unit)                   \
-    {(int64_t)(lo), (int64_t)(hi), json, (uint16_t)(off), (uint16_t)(stride),                       \
-     (uint16_t)MEMBER_OFF_##scope(member), (uint8_t)ODO_PF_##id, (uint8_t)ODO_PSCOPE_##scope,        \
-     (uint8_t)ODO_PTYPE_##type, (uint8_t)WIDTH_##type, (uint8_t)(since)},
+#define FIELD_ROW(id, scope, member, json, since, off, stride, type, lo, hi, unit) \
+    {(int64_t)(lo),                                                                \
+     (int64_t)(hi),                                                                \
+     json,                                                                         \
+     (uint16_t)(off),                                                              \
+     (uint16_t)(stride),                                                           \
+     (uint16_t)MEMBER_OFF_##scope(member),                                         \
+     (uint8_t)ODO_PF_##id,                                                         \
+     (uint8_t)ODO_PSCOPE_##scope,                                                  \
+     (uint8_t)ODO_PTYPE_##type,                                                    \
+     (uint8_t)WIDTH_##type,                                                        \
+     (uint8_t)(since)},
 
 static const odo_param_field_info_t k_fields[] = {ODO_PARAMS_FIELDS(FIELD_ROW)};
 #define N_FIELDS (sizeof k_fields / sizeof k_fields[0])
 
 /* A slip in the table fails the build: a width that is not the member's, a field that ends past
  * the CRC of the first version that carries it, or a range the field's type cannot hold. */
-#define FIELD_CHECKS(id, scope, member, json, since, off, stride, type, lo, hi, unit)                \
-    typedef char odo_assert_width_##id[(MEMBER_SIZE_##scope(member) == WIDTH_##type) ? 1 : -1];     \
-    typedef char odo_assert_fits_##id[((off) + (stride) + WIDTH_##type <=                           \
-                                       ((since) == 1 ? ODO_PARAMS_V1_CRC_OFFSET                      \
-                                                     : ODO_PARAMS_CRC_OFFSET)) ? 1 : -1];            \
-    typedef char odo_assert_range_##id[((lo) <= (hi) &&                                             \
-                                        ((ODO_PTYPE_##type == ODO_PTYPE_I32)                        \
-                                             ? ((lo) >= INT32_MIN && (hi) <= INT32_MAX)              \
-                                             : ((lo) >= 0 && (hi) < ((int64_t)1 << (8 * WIDTH_##type))))) \
-                                           ? 1 : -1];
+#define FIELD_CHECKS(id, scope, member, json, since, off, stride, type, lo, hi, unit)                            \
+    typedef char odo_assert_width_##id[(MEMBER_SIZE_##scope(member) == WIDTH_##type) ? 1 : -1];                  \
+    typedef char odo_assert_fits_##id[((off) + (stride) + WIDTH_##type <=                                        \
+                                       ((since) == 1 ? ODO_PARAMS_V1_CRC_OFFSET : ODO_PARAMS_CRC_OFFSET))        \
+                                          ? 1                                                                    \
+                                          : -1];                                                                 \
+    typedef char                                                                                                 \
+        odo_assert_range_##id[((lo) <= (hi) && ((ODO_PTYPE_##type == ODO_PTYPE_I32)                              \
+                                                    ? ((lo) >= INT32_MIN && (hi) <= INT32_MAX)                   \
+                                                    : ((lo) >= 0 && (hi) < ((int64_t)1 << (8 * WIDTH_##type))))) \
+                                  ? 1                                                                            \
+                                  : -1];
 ODO_PARAMS_FIELDS(FIELD_CHECKS)
 typedef char odo_assert_crc_last[(ODO_PARAMS_CRC_OFFSET + 4U == ODO_PARAMS_SIZE) ? 1 : -1];
 typedef char odo_assert_v1_crc_last[(ODO_PARAMS_V1_CRC_OFFSET + 4U == ODO_PARAMS_V1_SIZE) ? 1 : -1];
@@ -82,8 +92,7 @@ static int32_t as_i32(uint32_t u)
 
 static const uint8_t *member_c(const odo_params_t *p, const odo_param_field_info_t *f, unsigned t)
 {
-    const uint8_t *base = f->scope == (uint8_t)ODO_PSCOPE_TRUCK ? (const uint8_t *)&p->truck[t]
-                                                                : (const uint8_t *)p;
+    const uint8_t *base = f->scope == (uint8_t)ODO_PSCOPE_TRUCK ? (const uint8_t *)&p->truck[t] : (const uint8_t *)p;
     return base + f->member;
 }
 
@@ -210,27 +219,27 @@ void odo_params_defaults(odo_params_t *p)
     p->counter_bits = 24U;
     p->heading_form = (uint8_t)ODO_HEADING_MIDPOINT;
     p->ipec_mode = (uint8_t)ODO_IPEC_OFF;
-    p->tick_us = 40000UL;              /* 40 ms, 002 s. 4.1 */
-    p->max_wheel_speed_mm_s = 3000UL;  /* 3 m/s */
+    p->tick_us = 40000UL;             /* 40 ms, 002 s. 4.1 */
+    p->max_wheel_speed_mm_s = 3000UL; /* 3 m/s */
     for (unsigned t = 0U; t < ODO_TRUCKS; t++) {
         odo_truck_params_t *tr = &p->truck[t];
-        tr->wheel_diameter_nm = 150UL * (uint32_t)ODO_NM_PER_MM;  /* R = 75 mm, 004 Table I */
+        tr->wheel_diameter_nm = 150UL * (uint32_t)ODO_NM_PER_MM; /* R = 75 mm, 004 Table I */
         /* 500-line encoder, 4x decoding, 19.5:1 gear: 500 * 4 * 19.5 = 39000 counts per turn. */
         tr->counts_per_rev_milli = (500UL * 4UL * 195UL / 10UL) * 1000UL;
         tr->wheelbase_nm = 340UL * (uint32_t)ODO_NM_PER_MM;
         tr->ed_q30 = ODO_RATIO_Q30_ONE;
         tr->eb_q30 = ODO_RATIO_Q30_ONE;
         tr->es_q30 = ODO_RATIO_Q30_ONE;
-        tr->scrub_q30 = 0;  /* no tyre-scrub term: 000 Eq. 2.4 as it stands */
+        tr->scrub_q30 = 0; /* no tyre-scrub term: 000 Eq. 2.4 as it stands */
         tr->flags = 0U;
     }
-    p->link.length_nm = 1000UL * (uint32_t)ODO_NM_PER_MM;  /* 1 m clapper link, 004 s. 2 */
+    p->link.length_nm = 1000UL * (uint32_t)ODO_NM_PER_MM; /* 1 m clapper link, 004 s. 2 */
     p->link.hitch_offset_nm = 0U;
     p->link.length_bias_nm = 0;
     p->link.length_ecc_nm = 0;
     p->link.alpha_bias_bam = 0;
     p->link.beta_bias_bam = 0;
-    p->link.rotary_bits = 10U;  /* 004 */
+    p->link.rotary_bits = 10U; /* 004 */
     p->link.stale_ticks = 3U;
     p->link.max_jump_bam = (uint32_t)ODO_DEG_TO_BAM(10);
     p->link.max_length_jump_um = 20UL * (uint32_t)ODO_UM_PER_MM;
@@ -254,8 +263,7 @@ static odo_param_field_t check_scope(const odo_params_t *p, odo_param_scope_t sc
     return ODO_PF_NONE;
 }
 
-odo_params_status_t odo_params_validate(const odo_params_t *p, odo_param_field_t *bad_field,
-                                        uint8_t *bad_truck)
+odo_params_status_t odo_params_validate(const odo_params_t *p, odo_param_field_t *bad_field, uint8_t *bad_truck)
 {
     uint8_t truck = 0U;
 
@@ -293,7 +301,7 @@ size_t odo_params_encode(const odo_params_t *p, uint8_t *buf, size_t cap)
     if ((p == NULL) || (buf == NULL) || (cap < ODO_PARAMS_SIZE)) {
         return 0U;
     }
-    memset(buf, 0, ODO_PARAMS_SIZE);  /* reserved bytes are 0 */
+    memset(buf, 0, ODO_PARAMS_SIZE); /* reserved bytes are 0 */
     put_le(&buf[OFF_MAGIC], (uint32_t)ODO_PARAMS_MAGIC, 4U);
     put_le(&buf[OFF_VERSION], ODO_PARAMS_VERSION, 2U);
     put_le(&buf[OFF_LENGTH], ODO_PARAMS_SIZE, 2U);
@@ -422,24 +430,15 @@ odo_params_status_t odo_params_load(const uint8_t *buf, size_t len, odo_params_t
 const char *odo_params_status_str(odo_params_status_t s)
 {
     switch (s) {
-    case ODO_PARAMS_OK:
-        return "ok";
-    case ODO_PARAMS_ERR_SHORT:
-        return "block too short (fewer bytes than the header or the declared length)";
-    case ODO_PARAMS_ERR_MAGIC:
-        return "bad magic (not a parameter block)";
-    case ODO_PARAMS_ERR_VERSION:
-        return "unknown parameter block version";
-    case ODO_PARAMS_ERR_LENGTH:
-        return "declared length differs from this version's size";
-    case ODO_PARAMS_ERR_CRC:
-        return "CRC mismatch (corrupted in flash or in transit)";
-    case ODO_PARAMS_ERR_RANGE:
-        return "field out of range (or reserved byte non-zero)";
-    case ODO_PARAMS_ERR_ARG:
-        return "invalid argument (NULL pointer or buffer too small)";
-    default:
-        break;
+    case ODO_PARAMS_OK: return "ok";
+    case ODO_PARAMS_ERR_SHORT: return "block too short (fewer bytes than the header or the declared length)";
+    case ODO_PARAMS_ERR_MAGIC: return "bad magic (not a parameter block)";
+    case ODO_PARAMS_ERR_VERSION: return "unknown parameter block version";
+    case ODO_PARAMS_ERR_LENGTH: return "declared length differs from this version's size";
+    case ODO_PARAMS_ERR_CRC: return "CRC mismatch (corrupted in flash or in transit)";
+    case ODO_PARAMS_ERR_RANGE: return "field out of range (or reserved byte non-zero)";
+    case ODO_PARAMS_ERR_ARG: return "invalid argument (NULL pointer or buffer too small)";
+    default: break;
     }
     return "unknown status";
 }

@@ -6,17 +6,14 @@
 /// pi / 2 in Q30: radians per BAM x 2^30 is pi / 2^31 x 2^30 = pi / 2.
 #define PI_2_Q30 1686629713L
 /// mm Q40 -> um: x 1000 / 2^40.
-#define Q40_MM 40U
+#define Q40_MM   40U
 
-void odo_selfcal_init(odo_selfcal_t *s)
-{
-    memset(s, 0, sizeof *s);
-}
+void odo_selfcal_init(odo_selfcal_t *s) { memset(s, 0, sizeof *s); }
 
 static int64_t abs64(int64_t v) { return v < 0 ? -v : v; }
 
-void odo_selfcal_add(odo_selfcal_t *s, uint8_t truck, uint32_t wheelbase_nm, uint8_t rotary_bits,
-                     int64_t dist_mm_q40, int64_t dturn_q64, int32_t dtheta_bam)
+void odo_selfcal_add(odo_selfcal_t *s, uint8_t truck, uint32_t wheelbase_nm, uint8_t rotary_bits, int64_t dist_mm_q40,
+                     int64_t dturn_q64, int32_t dtheta_bam)
 {
     if (truck >= ODO_TRUCKS) {
         return;
@@ -70,10 +67,7 @@ static int64_t ratio_q30(int64_t num, int64_t den)
     return (num * ((int64_t)1 << 30)) / den;
 }
 
-static int32_t clamp_q30(int64_t v, int64_t lim)
-{
-    return (int32_t)(v > lim ? lim : (v < -lim ? -lim : v));
-}
+static int32_t clamp_q30(int64_t v, int64_t lim) { return (int32_t)(v > lim ? lim : (v < -lim ? -lim : v)); }
 
 /// f / (1 + x), Q30 in and out (|x| <= 1/8).
 static int32_t div_one_plus(int32_t f_q30, int32_t x_q30)
@@ -81,8 +75,7 @@ static int32_t div_one_plus(int32_t f_q30, int32_t x_q30)
     return (int32_t)(((int64_t)f_q30 * ((int64_t)1 << 30)) / (((int64_t)1 << 30) + x_q30));
 }
 
-bool odo_selfcal_estimate(const odo_selfcal_t *s, const odo_params_t *in, odo_params_t *out,
-                          odo_selfcal_result_t *r)
+bool odo_selfcal_estimate(const odo_selfcal_t *s, const odo_params_t *in, odo_params_t *out, odo_selfcal_result_t *r)
 {
     odo_selfcal_result_t res;
     memset(&res, 0, sizeof res);
@@ -99,8 +92,9 @@ bool odo_selfcal_estimate(const odo_selfcal_t *s, const odo_params_t *in, odo_pa
             /* k = -b_f sum(sgn U C) / sum|U|, C in radians = BAM pi / 2^31:
              * k_q30 = -sum(C) b_um (pi / 2) / sum|U|_um. */
             /* |C| sums beyond 16 turns are not calibration data; the clamp keeps the products in range. */
-            const int64_t c = t->straight_corr > ((int64_t)1 << 36) ? ((int64_t)1 << 36)
-                            : (t->straight_corr < -((int64_t)1 << 36) ? -((int64_t)1 << 36) : t->straight_corr);
+            const int64_t c = t->straight_corr > ((int64_t)1 << 36)
+                                  ? ((int64_t)1 << 36)
+                                  : (t->straight_corr < -((int64_t)1 << 36) ? -((int64_t)1 << 36) : t->straight_corr);
             const int64_t num = odo_mul_s64_s32_shr(c * bf_um, PI_2_Q30, 30U);
             res.k_q30[i] = clamp_q30(-(num / t->straight_um), lim);
             res.corr_per_m_bam[i] = (int32_t)((c * 1000000) / t->straight_um);

@@ -36,8 +36,7 @@
 #include "odo/odo_fx.h"
 
 /// One octant of a turn in BAM (pi/4), and the mask of the remainder inside an octant.
-#define OCTANT_BAM  ((uint32_t)1U << 29)
-
+#define OCTANT_BAM ((uint32_t)1U << 29)
 
 /// round(pi * 2^30). A remainder r of BAM in an octant is r * (pi/4) / 2^29 rad, which in Q32 is
 /// r * 2 pi = r * PI_Q30 / 2^29; r <= 2^29 keeps the product below 2^61.
@@ -55,10 +54,7 @@
 #define RECIP_Q32(d) ((uint32_t)((((uint64_t)1U << 32) + (uint64_t)(d) / 2U) / (uint64_t)(d)))
 
 /// floor(a * b / 2^32): one UMULL, the high word.
-static inline uint32_t mulhi(uint32_t a, uint32_t b)
-{
-    return (uint32_t)(((uint64_t)a * b) >> 32);
-}
+static inline uint32_t mulhi(uint32_t a, uint32_t b) { return (uint32_t)(((uint64_t)a * b) >> 32); }
 
 /// round(a * b / 2^32), half up: UMULL and a carry.
 static inline uint32_t mulhi_round(uint32_t a, uint32_t b)
@@ -71,17 +67,14 @@ static inline uint32_t mulhi_round(uint32_t a, uint32_t b)
 /// decimal arithmetic (every value is at least 0.005 LSB from a rounding tie);
 /// tests/unit/test_trig.c checks each entry against libm.
 const uint32_t odo_sin_table_q31[ODO_SIN_TABLE_SIZE] = {
-    0U, 52701887U, 105372028U, 157978697U, 210490206U, 262874923U,
-    315101295U, 367137861U, 418953276U, 470516330U, 521795963U, 572761285U,
-    623381598U, 673626408U, 723465451U, 772868706U, 821806413U, 870249095U,
-    918167572U, 965532978U, 1012316784U, 1058490808U, 1104027237U, 1148898640U,
-    1193077991U, 1236538675U, 1279254516U, 1321199781U, 1362349204U, 1402678000U,
-    1442161874U, 1480777044U, 1518500250U, 1555308768U, 1591180426U, 1626093616U,
-    1660027308U, 1692961062U, 1724875040U, 1755750017U, 1785567396U, 1814309216U,
-    1841958164U, 1868497586U, 1893911494U, 1918184581U, 1941302225U, 1963250501U,
-    1984016189U, 2003586779U, 2021950484U, 2039096241U, 2055013723U, 2069693342U,
-    2083126254U, 2095304370U, 2106220352U, 2115867626U, 2124240380U, 2131333572U,
-    2137142927U, 2141664948U, 2144896910U, 2146836866U, 2147483648U,
+    0U,          52701887U,   105372028U,  157978697U,  210490206U,  262874923U,  315101295U,  367137861U,  418953276U,
+    470516330U,  521795963U,  572761285U,  623381598U,  673626408U,  723465451U,  772868706U,  821806413U,  870249095U,
+    918167572U,  965532978U,  1012316784U, 1058490808U, 1104027237U, 1148898640U, 1193077991U, 1236538675U, 1279254516U,
+    1321199781U, 1362349204U, 1402678000U, 1442161874U, 1480777044U, 1518500250U, 1555308768U, 1591180426U, 1626093616U,
+    1660027308U, 1692961062U, 1724875040U, 1755750017U, 1785567396U, 1814309216U, 1841958164U, 1868497586U, 1893911494U,
+    1918184581U, 1941302225U, 1963250501U, 1984016189U, 2003586779U, 2021950484U, 2039096241U, 2055013723U, 2069693342U,
+    2083126254U, 2095304370U, 2106220352U, 2115867626U, 2124240380U, 2131333572U, 2137142927U, 2141664948U, 2144896910U,
+    2146836866U, 2147483648U,
 };
 
 void odo_sincos_q30(uint32_t angle_bam, int32_t *sin_q30, int32_t *cos_q30)
@@ -138,19 +131,31 @@ static unsigned excess_bits_over_30(uint64_t v)
     if ((v >> 62) != 0U) {
         return 33U + (unsigned)(v >> 63);
     }
-    if (h >= ((uint32_t)1U << 16)) { h >>= 16; n += 16U; }
-    if (h >= ((uint32_t)1U << 8)) { h >>= 8; n += 8U; }
-    if (h >= ((uint32_t)1U << 4)) { h >>= 4; n += 4U; }
-    if (h >= ((uint32_t)1U << 2)) { h >>= 2; n += 2U; }
-    if (h >= ((uint32_t)1U << 1)) { h >>= 1; n += 1U; }
+    if (h >= ((uint32_t)1U << 16)) {
+        h >>= 16;
+        n += 16U;
+    }
+    if (h >= ((uint32_t)1U << 8)) {
+        h >>= 8;
+        n += 8U;
+    }
+    if (h >= ((uint32_t)1U << 4)) {
+        h >>= 4;
+        n += 4U;
+    }
+    if (h >= ((uint32_t)1U << 2)) {
+        h >>= 2;
+        n += 2U;
+    }
+    if (h >= ((uint32_t)1U << 1)) {
+        h >>= 1;
+        n += 1U;
+    }
     return n + (unsigned)h;
 }
 
 /// v / 2^s rounded half up, s in [0, 34]; v <= 2^63 so the bias cannot overflow.
-static uint64_t shr_round_u64(uint64_t v, unsigned s)
-{
-    return s == 0U ? v : (v + ((uint64_t)1U << (s - 1U))) >> s;
-}
+static uint64_t shr_round_u64(uint64_t v, unsigned s) { return s == 0U ? v : (v + ((uint64_t)1U << (s - 1U))) >> s; }
 
 uint32_t odo_atan2_bam(int64_t y, int64_t x)
 {

@@ -5,14 +5,14 @@
 
 #include "odo/odo_fx.h"
 
-#define Q30_ONE     ((int64_t)1 << 30)
+#define Q30_ONE          ((int64_t)1 << 30)
 /* 2^64 / (2 pi): BAM per radian in Q32 (the constant odo_odometry.c uses; checked there). */
-#define BAM_PER_RAD_Q32 2935890503282001226ULL
+#define BAM_PER_RAD_Q32  2935890503282001226ULL
 /* Parameter block ratio range, as odo_params.c checks it (0.8 truncated to Q30, 1.25 exact). */
-#define RATIO_MIN_Q30 ((int64_t)(((int64_t)4 << 30) / 5))
-#define RATIO_MAX_Q30 ((int64_t)(((int64_t)5 << 30) / 4))
+#define RATIO_MIN_Q30    ((int64_t)(((int64_t)4 << 30) / 5))
+#define RATIO_MAX_Q30    ((int64_t)(((int64_t)5 << 30) / 4))
 /* A Type A or B angle beyond 45 deg is not a small systematic error: refuse it. */
-#define ANGLE_LIMIT_BAM ((int64_t)1 << 29)
+#define ANGLE_LIMIT_BAM  ((int64_t)1 << 29)
 #define WHEELBASE_MIN_NM 50000000U
 #define WHEELBASE_MAX_NM 3000000000U
 
@@ -51,8 +51,8 @@ static int64_t div_round_s64(int64_t num, int64_t den)
     return num >= 0 ? (num + half) / den : -((-num + half) / den);
 }
 
-odo_umb_status_t odo_umb_stats(const odo_umb_return_t *cw, size_t n_cw, const odo_umb_return_t *ccw,
-                               size_t n_ccw, odo_umb_stats_t *out)
+odo_umb_status_t odo_umb_stats(const odo_umb_return_t *cw, size_t n_cw, const odo_umb_return_t *ccw, size_t n_ccw,
+                               odo_umb_stats_t *out)
 {
     if (cw == NULL || ccw == NULL || out == NULL) {
         return ODO_UMB_ERR_ARG;
@@ -71,9 +71,9 @@ odo_umb_status_t odo_umb_stats(const odo_umb_return_t *cw, size_t n_cw, const od
         int64_t st = 0;
         for (size_t i = 0U; i < n[d]; ++i) {
             const odo_umb_return_t *r = &runs[d][i];
-            if (r->ex_um < -ODO_UMB_MAX_ERR_UM || r->ex_um > ODO_UMB_MAX_ERR_UM ||
-                r->ey_um < -ODO_UMB_MAX_ERR_UM || r->ey_um > ODO_UMB_MAX_ERR_UM ||
-                r->etheta_udeg < -ODO_UMB_MAX_THETA_UDEG || r->etheta_udeg > ODO_UMB_MAX_THETA_UDEG) {
+            if (r->ex_um < -ODO_UMB_MAX_ERR_UM || r->ex_um > ODO_UMB_MAX_ERR_UM || r->ey_um < -ODO_UMB_MAX_ERR_UM ||
+                r->ey_um > ODO_UMB_MAX_ERR_UM || r->etheta_udeg < -ODO_UMB_MAX_THETA_UDEG ||
+                r->etheta_udeg > ODO_UMB_MAX_THETA_UDEG) {
                 return ODO_UMB_ERR_INPUT;
             }
             sx += r->ex_um;
@@ -88,8 +88,8 @@ odo_umb_status_t odo_umb_stats(const odo_umb_return_t *cw, size_t n_cw, const od
         /* 000 Eq. 3.6 */
         s.theta_bias_udeg[d] = (int32_t)div_round_s64(st, (int64_t)n[d]);
         /* 000 Eq. 3.3: |cg| <= 2^25.5 um, squares fit easily. */
-        const uint64_t r2 = (uint64_t)((int64_t)s.cg_x_um[d] * s.cg_x_um[d]) +
-                            (uint64_t)((int64_t)s.cg_y_um[d] * s.cg_y_um[d]);
+        const uint64_t r2 =
+            (uint64_t)((int64_t)s.cg_x_um[d] * s.cg_x_um[d]) + (uint64_t)((int64_t)s.cg_y_um[d] * s.cg_y_um[d]);
         s.r_cg_um[d] = (uint32_t)isqrt_round_u64(r2);
     }
     /* 000 Eq. 3.4 */
@@ -163,8 +163,8 @@ bool odo_umb_correction_factors(int32_t ed_q30, int32_t *cl_q30, int32_t *cr_q30
     return true;
 }
 
-odo_umb_status_t odo_umb_calibrate(const odo_umb_stats_t *s, uint32_t side_um, uint32_t wheelbase_nm,
-                                   int32_t ed_q30, int32_t eb_q30, odo_umb_calib_t *out)
+odo_umb_status_t odo_umb_calibrate(const odo_umb_stats_t *s, uint32_t side_um, uint32_t wheelbase_nm, int32_t ed_q30,
+                                   int32_t eb_q30, odo_umb_calib_t *out)
 {
     if (s == NULL || out == NULL) {
         return ODO_UMB_ERR_ARG;
@@ -172,8 +172,7 @@ odo_umb_status_t odo_umb_calibrate(const odo_umb_stats_t *s, uint32_t side_um, u
     if (side_um < ODO_UMB_MIN_SIDE_UM || side_um > ODO_UMB_MAX_SIDE_UM) {
         return ODO_UMB_ERR_SIDE;
     }
-    if (wheelbase_nm < WHEELBASE_MIN_NM || wheelbase_nm > WHEELBASE_MAX_NM || !ratio_ok(ed_q30) ||
-        !ratio_ok(eb_q30)) {
+    if (wheelbase_nm < WHEELBASE_MIN_NM || wheelbase_nm > WHEELBASE_MAX_NM || !ratio_ok(ed_q30) || !ratio_ok(eb_q30)) {
         return ODO_UMB_ERR_GEOMETRY;
     }
     odo_umb_calib_t c;
@@ -242,9 +241,8 @@ odo_umb_status_t odo_umb_calibrate(const odo_umb_stats_t *s, uint32_t side_um, u
     return ODO_UMB_OK;
 }
 
-odo_umb_status_t odo_umb_nonsys_theta(const odo_umb_return_t *cw, size_t n_cw,
-                                      const odo_umb_return_t *ccw, size_t n_ccw,
-                                      const int32_t theta_bias_udeg[2], uint32_t *out_udeg)
+odo_umb_status_t odo_umb_nonsys_theta(const odo_umb_return_t *cw, size_t n_cw, const odo_umb_return_t *ccw,
+                                      size_t n_ccw, const int32_t theta_bias_udeg[2], uint32_t *out_udeg)
 {
     if (cw == NULL || ccw == NULL || theta_bias_udeg == NULL || out_udeg == NULL) {
         return ODO_UMB_ERR_ARG;

@@ -20,9 +20,9 @@
 
 static int fail(const char *out_path, const char *why)
 {
-    fprintf(stderr, "gen_param_block: %s\n", why);
+    (void)fprintf(stderr, "gen_param_block: %s\n", why);
     if (out_path != NULL) {
-        remove(out_path);
+        (void)remove(out_path);
     }
     return EXIT_FAILURE;
 }
@@ -30,7 +30,7 @@ static int fail(const char *out_path, const char *why)
 int main(int argc, char **argv)
 {
     if (argc != 2) {
-        fprintf(stderr, "usage: %s OUT.c\n", argc > 0 ? argv[0] : "gen_param_block");
+        (void)fprintf(stderr, "usage: %s OUT.c\n", argc > 0 ? argv[0] : "gen_param_block");
         return EXIT_FAILURE;
     }
     const char *out_path = argv[1];
@@ -48,8 +48,7 @@ int main(int argc, char **argv)
     odo_params_t back;
     odo_params_status_t st = odo_params_decode(block, sizeof block, &back);
     if (st != ODO_PARAMS_OK) {
-        fprintf(stderr, "gen_param_block: the default block does not decode: %s\n",
-                odo_params_status_str(st));
+        (void)fprintf(stderr, "gen_param_block: the default block does not decode: %s\n", odo_params_status_str(st));
         return EXIT_FAILURE;
     }
 
@@ -58,23 +57,23 @@ int main(int argc, char **argv)
         perror(out_path);
         return EXIT_FAILURE;
     }
-    fprintf(f,
-            "/* Generated at build time by hal/cortexm/gen_param_block.c from odo_params_defaults().\n"
-            " * Do not edit: change the defaults in firmware/src/odo_params.c, or patch a built image\n"
-            " * with `odo-calib write`. Layout: firmware/include/odo/odo_params.h. */\n"
-            "#include \"odo_board.h\"\n\n"
-            "/* The block's size as a link-time constant, for odo_cm4.ld's ASSERT on .odo_params. */\n"
-            "__asm__(\".global __odo_params_block_size\\n\\t.set __odo_params_block_size, %u\");\n\n"
-            "__attribute__((section(\".odo_params\"), used, aligned(4)))\n"
-            "const uint8_t odo_param_block[ODO_PARAMS_SIZE] = {\n",
-            ODO_PARAMS_SIZE);
+    (void)fprintf(f,
+                  "/* Generated at build time by hal/cortexm/gen_param_block.c from odo_params_defaults().\n"
+                  " * Do not edit: change the defaults in firmware/src/odo_params.c, or patch a built image\n"
+                  " * with `odo-calib write`. Layout: firmware/include/odo/odo_params.h. */\n"
+                  "#include \"odo_board.h\"\n\n"
+                  "/* The block's size as a link-time constant, for odo_cm4.ld's ASSERT on .odo_params. */\n"
+                  "__asm__(\".global __odo_params_block_size\\n\\t.set __odo_params_block_size, %u\");\n\n"
+                  "__attribute__((section(\".odo_params\"), used, aligned(4)))\n"
+                  "const uint8_t odo_param_block[ODO_PARAMS_SIZE] = {\n",
+                  ODO_PARAMS_SIZE);
     for (size_t i = 0; i < sizeof block; ++i) {
-        fprintf(f, "%s0x%02XU,%s", (i % 12U) == 0U ? "    " : " ", (unsigned)block[i],
-                ((i % 12U) == 11U || i + 1U == sizeof block) ? "\n" : "");
+        (void)fprintf(f, "%s0x%02XU,%s", (i % 12U) == 0U ? "    " : " ", (unsigned)block[i],
+                      ((i % 12U) == 11U || i + 1U == sizeof block) ? "\n" : "");
     }
-    fprintf(f, "};\n");
+    (void)fprintf(f, "};\n");
     if (ferror(f) != 0) {
-        fclose(f);
+        (void)fclose(f);
         return fail(out_path, "write error");
     }
     if (fclose(f) != 0) {

@@ -10,10 +10,10 @@
 #include "odo_board.h"
 
 #define GPIO(port) ((odo_stm32_gpio_t *)ODO_STM32_GPIO_BASE(port))
-#define PA 0U
-#define PB 1U
-#define PE 4U
-#define TIM(base) ((odo_stm32_tim_t *)(base))
+#define PA         0U
+#define PB         1U
+#define PE         4U
+#define TIM(base)  ((odo_stm32_tim_t *)(base))
 
 #ifndef ODO_CM4_WHEEL_SOURCE
 #define ODO_CM4_WHEEL_SOURCE ODO_WHEELS_ENCODER
@@ -26,30 +26,30 @@ const odo_board_config_t odo_board_config = {
     .can = (odo_stm32_can_t *)ODO_STM32_CAN1_BASE,
     .tick_tim = TIM(ODO_STM32_TIM7_BASE),
     .tick_tim_apb1enr = ODO_RCC_APB1ENR_TIM7,
-    .hse_hz = 8000000UL,
-    .tick_us = 40000UL,
-    .can_bitrate = 500000UL,
+    .hse_hz = 8000000U,
+    .tick_us = 40000U,
+    .can_bitrate = 500000U,
     .can_rx = {GPIO(PB), PB, 8U, 9U},
     .can_tx = {GPIO(PB), PB, 9U, 9U},
     .watchdog_ms = 200U,
-    .polls = 200000UL,
+    .polls = 200000U,
     .encoder_filter = 3U,
-    .truck = {
-        {.source = ODO_CM4_WHEEL_SOURCE,
-         .tim = {TIM(ODO_STM32_TIM2_BASE), TIM(ODO_STM32_TIM5_BASE)},
-         .tim_apb1enr = {ODO_RCC_APB1ENR_TIM2, ODO_RCC_APB1ENR_TIM5},
-         .tim_bits = {32U, 32U},
-         .ti = {{{GPIO(PA), PA, 15U, 1U}, {GPIO(PB), PB, 3U, 1U}},
-                {{GPIO(PA), PA, 0U, 2U}, {GPIO(PA), PA, 1U, 2U}}},
-         .hctl_chip = {0U, 1U}},
-        {.source = ODO_CM4_WHEEL_SOURCE,
-         .tim = {TIM(ODO_STM32_TIM3_BASE), TIM(ODO_STM32_TIM4_BASE)},
-         .tim_apb1enr = {ODO_RCC_APB1ENR_TIM3, ODO_RCC_APB1ENR_TIM4},
-         .tim_bits = {16U, 16U},
-         .ti = {{{GPIO(PA), PA, 6U, 2U}, {GPIO(PA), PA, 7U, 2U}},
-                {{GPIO(PB), PB, 6U, 2U}, {GPIO(PB), PB, 7U, 2U}}},
-         .hctl_chip = {2U, 3U}},
-    },
+    .truck =
+        {
+            {.source = ODO_CM4_WHEEL_SOURCE,
+             .tim = {TIM(ODO_STM32_TIM2_BASE), TIM(ODO_STM32_TIM5_BASE)},
+             .tim_apb1enr = {ODO_RCC_APB1ENR_TIM2, ODO_RCC_APB1ENR_TIM5},
+             .tim_bits = {32U, 32U},
+             .ti = {{{GPIO(PA), PA, 15U, 1U}, {GPIO(PB), PB, 3U, 1U}},
+                    {{GPIO(PA), PA, 0U, 2U}, {GPIO(PA), PA, 1U, 2U}}},
+             .hctl_chip = {0U, 1U}},
+            {.source = ODO_CM4_WHEEL_SOURCE,
+             .tim = {TIM(ODO_STM32_TIM3_BASE), TIM(ODO_STM32_TIM4_BASE)},
+             .tim_apb1enr = {ODO_RCC_APB1ENR_TIM3, ODO_RCC_APB1ENR_TIM4},
+             .tim_bits = {16U, 16U},
+             .ti = {{{GPIO(PA), PA, 6U, 2U}, {GPIO(PA), PA, 7U, 2U}}, {{GPIO(PB), PB, 6U, 2U}, {GPIO(PB), PB, 7U, 2U}}},
+             .hctl_chip = {2U, 3U}},
+        },
     .hctl = {GPIO(PE), GPIO(PE), 8U, 9U, 10U, {11U, 12U, 13U, 14U}, 4U, 8U},
     .hctl_port_index = {PE, PE},
 };

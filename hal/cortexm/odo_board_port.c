@@ -28,9 +28,9 @@ static void pin_af(odo_stm32_rcc_t *rcc, const odo_pin_t *p, bool pull_up)
     }
     odo_reg_modify(&rcc->AHB1ENR, 0U, ODO_RCC_AHB1ENR_GPIO(p->port_index));
     const uint32_t sh2 = 2U * p->pin, sh4 = 4U * (p->pin & 7U);
-    odo_reg_modify(&p->port->AFR[p->pin >> 3], 0xFUL << sh4, (uint32_t)(p->af & 0xFU) << sh4);
-    odo_reg_modify(&p->port->PUPDR, 3UL << sh2, pull_up ? (uint32_t)ODO_GPIO_PULL_UP << sh2 : 0U);
-    odo_reg_modify(&p->port->MODER, 3UL << sh2, (uint32_t)ODO_GPIO_MODE_AF << sh2);
+    odo_reg_modify(&p->port->AFR[p->pin >> 3], (uint32_t)0xFU << sh4, (uint32_t)(p->af & 0xFU) << sh4);
+    odo_reg_modify(&p->port->PUPDR, 3U << sh2, pull_up ? (uint32_t)ODO_GPIO_PULL_UP << sh2 : 0U);
+    odo_reg_modify(&p->port->MODER, 3U << sh2, (uint32_t)ODO_GPIO_MODE_AF << sh2);
 }
 
 static bool any_source(const odo_board_config_t *cfg, odo_wheel_source_t s)
@@ -60,8 +60,8 @@ void odo_board_init(hal_ctx_t *hal, const odo_board_config_t *cfg)
         }
     }
     if (any_source(cfg, ODO_WHEELS_HCTL)) {
-        odo_reg_modify(&rcc->AHB1ENR, 0U, ODO_RCC_AHB1ENR_GPIO(cfg->hctl_port_index[0]) |
-                                              ODO_RCC_AHB1ENR_GPIO(cfg->hctl_port_index[1]));
+        odo_reg_modify(&rcc->AHB1ENR, 0U,
+                       ODO_RCC_AHB1ENR_GPIO(cfg->hctl_port_index[0]) | ODO_RCC_AHB1ENR_GPIO(cfg->hctl_port_index[1]));
         odo_hctl_bus_init(&cfg->hctl);
     }
 
@@ -153,7 +153,7 @@ bool hal_wheel_read(hal_ctx_t *ctx, uint8_t truck, odo_wheel_input_t *out)
     switch (io->source) {
     case ODO_WHEELS_ENCODER: {
         const uint8_t bits = io->tim_bits[0] < io->tim_bits[1] ? io->tim_bits[0] : io->tim_bits[1];
-        const uint32_t mask = bits >= 32U ? UINT32_MAX : ((1UL << bits) - 1UL);
+        const uint32_t mask = bits >= 32U ? UINT32_MAX : (((uint32_t)1U << bits) - 1U);
         out->left_raw = odo_encoder_read(io->tim[0]) & mask;
         out->right_raw = odo_encoder_read(io->tim[1]) & mask;
         out->bits = bits;
@@ -164,12 +164,9 @@ bool hal_wheel_read(hal_ctx_t *ctx, uint8_t truck, odo_wheel_input_t *out)
         out->right_raw = odo_hctl_read_position(&ctx->cfg->hctl, io->hctl_chip[1]);
         out->bits = ODO_HCTL_BITS;
         break;
-    case ODO_WHEELS_CAN:
-        *out = ctx->can_wheel[truck];
-        return true;
+    case ODO_WHEELS_CAN: *out = ctx->can_wheel[truck]; return true;
     case ODO_WHEELS_NONE:
-    default:
-        return false;
+    default: return false;
     }
     out->present = true;
     out->seq = ctx->seq[truck]++;

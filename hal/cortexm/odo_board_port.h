@@ -38,60 +38,60 @@ typedef enum {
 /// One pin in alternate-function mode (RM0090 8.3.2: AF number per pin in AFRL/AFRH).
 typedef struct {
     odo_stm32_gpio_t *port;
-    uint8_t           port_index; ///< 0 = GPIOA .. 8 = GPIOI (its RCC_AHB1ENR bit)
-    uint8_t           pin;
-    uint8_t           af;
+    uint8_t port_index; ///< 0 = GPIOA .. 8 = GPIOI (its RCC_AHB1ENR bit)
+    uint8_t pin;
+    uint8_t af;
 } odo_pin_t;
 
 typedef struct {
     odo_wheel_source_t source;
-    odo_stm32_tim_t   *tim[2];       ///< ENCODER: left, right
-    uint32_t           tim_apb1enr[2]; ///< their RCC_APB1ENR bits
-    uint8_t            tim_bits[2];  ///< 16 (TIM3/4) or 32 (TIM2/5)
-    odo_pin_t          ti[2][2];     ///< ENCODER: TI1, TI2 of each wheel
-    bool               invert[2];    ///< count direction reversed (encoder mounted mirrored)
-    uint8_t            hctl_chip[2]; ///< HCTL: chip index of left, right on the bus
+    odo_stm32_tim_t *tim[2]; ///< ENCODER: left, right
+    uint32_t tim_apb1enr[2]; ///< their RCC_APB1ENR bits
+    uint8_t tim_bits[2];     ///< 16 (TIM3/4) or 32 (TIM2/5)
+    odo_pin_t ti[2][2];      ///< ENCODER: TI1, TI2 of each wheel
+    bool invert[2];          ///< count direction reversed (encoder mounted mirrored)
+    uint8_t hctl_chip[2];    ///< HCTL: chip index of left, right on the bus
 } odo_truck_io_t;
 
 typedef struct {
-    odo_stm32_rcc_t   *rcc;
+    odo_stm32_rcc_t *rcc;
     odo_stm32_flash_t *flash;
-    odo_stm32_iwdg_t  *iwdg;
-    odo_stm32_can_t   *can;
-    odo_stm32_tim_t   *tick_tim;
-    uint32_t           tick_tim_apb1enr;
-    uint32_t           hse_hz;        ///< crystal (0: none, run from HSI)
-    uint32_t           tick_us;       ///< step period; the parameter block's tick_us should match
-    uint32_t           can_bitrate;   ///< bit/s, e.g. 500000
-    odo_pin_t          can_rx;
-    odo_pin_t          can_tx;
-    uint32_t           watchdog_ms;   ///< 0: no watchdog
-    uint32_t           polls;         ///< bound of every hardware wait, in register reads
-    uint8_t            encoder_filter; ///< IC1F/IC2F of the encoder timers
-    odo_truck_io_t     truck[ODO_TRUCKS];
-    odo_hctl_bus_t     hctl;
-    uint8_t            hctl_port_index[2]; ///< data, ctrl ports (RCC_AHB1ENR bits)
+    odo_stm32_iwdg_t *iwdg;
+    odo_stm32_can_t *can;
+    odo_stm32_tim_t *tick_tim;
+    uint32_t tick_tim_apb1enr;
+    uint32_t hse_hz;      ///< crystal (0: none, run from HSI)
+    uint32_t tick_us;     ///< step period; the parameter block's tick_us should match
+    uint32_t can_bitrate; ///< bit/s, e.g. 500000
+    odo_pin_t can_rx;
+    odo_pin_t can_tx;
+    uint32_t watchdog_ms;   ///< 0: no watchdog
+    uint32_t polls;         ///< bound of every hardware wait, in register reads
+    uint8_t encoder_filter; ///< IC1F/IC2F of the encoder timers
+    odo_truck_io_t truck[ODO_TRUCKS];
+    odo_hctl_bus_t hctl;
+    uint8_t hctl_port_index[2]; ///< data, ctrl ports (RCC_AHB1ENR bits)
 } odo_board_config_t;
 
 /// What start-up found; kept in RAM (odo_board_status in the image) for a debugger.
 typedef struct {
-    odo_clock_t        clock;
-    odo_bxcan_status_t can;        ///< ODO_BXCAN_OK or why CAN is down (the loop runs anyway)
-    bool               tick_ok;
-    bool               watchdog_ok;
-    uint32_t           tick_overruns; ///< periods that ended while the previous tick still ran
-    uint32_t           tx_refused;    ///< frames no mailbox took
+    odo_clock_t clock;
+    odo_bxcan_status_t can; ///< ODO_BXCAN_OK or why CAN is down (the loop runs anyway)
+    bool tick_ok;
+    bool watchdog_ok;
+    uint32_t tick_overruns; ///< periods that ended while the previous tick still ran
+    uint32_t tx_refused;    ///< frames no mailbox took
 } odo_board_status_t;
 
 /// The hal.h backend's context.
 struct hal_ctx {
     const odo_board_config_t *cfg;
-    odo_board_status_t        status;
-    odo_board_rx_t            rx;
-    odo_wheel_input_t         can_wheel[ODO_TRUCKS]; ///< this tick's WHEEL_COUNTS samples
-    odo_link_input_t          link;                  ///< this tick's linkage samples
-    uint8_t                   seq[ODO_TRUCKS];       ///< sample numbers of local counters
-    uint64_t                  periods;               ///< tick periods elapsed since start
+    odo_board_status_t status;
+    odo_board_rx_t rx;
+    odo_wheel_input_t can_wheel[ODO_TRUCKS]; ///< this tick's WHEEL_COUNTS samples
+    odo_link_input_t link;                   ///< this tick's linkage samples
+    uint8_t seq[ODO_TRUCKS];                 ///< sample numbers of local counters
+    uint64_t periods;                        ///< tick periods elapsed since start
 };
 
 /// Clocks, pins, counters, CAN, tick timer and (last) the watchdog, from *cfg (kept by pointer).

@@ -96,10 +96,7 @@ void odo_board_rx_bus_off(odo_board_rx_t *rx)
     inc(&rx->count.error_frames);
 }
 
-void odo_board_rx_overrun(odo_board_rx_t *rx)
-{
-    inc(&rx->count.overruns);
-}
+void odo_board_rx_overrun(odo_board_rx_t *rx) { inc(&rx->count.overruns); }
 
 void odo_board_rx_take(odo_board_rx_t *rx, odo_wheel_input_t wheel[ODO_TRUCKS], odo_link_input_t *link,
                        uint32_t *faults)

@@ -34,10 +34,10 @@ typedef struct {
 } odo_board_rx_counts_t;
 
 typedef struct {
-    bool                  can_wheels[ODO_TRUCKS]; ///< truck's counters arrive as WHEEL_COUNTS
-    odo_wheel_input_t     wheel[ODO_TRUCKS];      ///< present: a frame arrived this tick
-    odo_link_input_t      link;                   ///< *_present: a frame arrived this tick
-    uint32_t              faults;                 ///< ODO_FAULT_* bits of this tick's frames
+    bool can_wheels[ODO_TRUCKS];         ///< truck's counters arrive as WHEEL_COUNTS
+    odo_wheel_input_t wheel[ODO_TRUCKS]; ///< present: a frame arrived this tick
+    odo_link_input_t link;               ///< *_present: a frame arrived this tick
+    uint32_t faults;                     ///< ODO_FAULT_* bits of this tick's frames
     odo_board_rx_counts_t count;
 } odo_board_rx_t;
 

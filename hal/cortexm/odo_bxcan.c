@@ -43,8 +43,8 @@ bool odo_bxcan_timing(uint32_t pclk1_hz, uint32_t bitrate, uint32_t *btr, uint32
     return found;
 }
 
-odo_bxcan_status_t odo_bxcan_init(odo_stm32_can_t *can, uint32_t pclk1_hz, uint32_t bitrate,
-                                  const uint32_t *ids, uint8_t n_ids, uint32_t polls)
+odo_bxcan_status_t odo_bxcan_init(odo_stm32_can_t *can, uint32_t pclk1_hz, uint32_t bitrate, const uint32_t *ids,
+                                  uint8_t n_ids, uint32_t polls)
 {
     uint32_t btr = 0U;
     if (!odo_bxcan_timing(pclk1_hz, bitrate, &btr, NULL)) {
@@ -76,15 +76,15 @@ odo_bxcan_status_t odo_bxcan_init(odo_stm32_can_t *can, uint32_t pclk1_hz, uint3
             const uint8_t i = (uint8_t)(4U * b + k);
             slot[k] = (ids[i < n_ids ? i : n_ids - 1U] & 0x7FFU) << 5;
         }
-        bank_mask |= 1UL << b;
-        odo_reg_modify(&can->FA1R, 1UL << b, 0U); /* a bank is written only while inactive */
+        bank_mask |= (uint32_t)1U << b;
+        odo_reg_modify(&can->FA1R, (uint32_t)1U << b, 0U); /* a bank is written only while inactive */
         odo_reg_write(&can->filter[b].FR1, slot[0] | (slot[1] << 16));
         odo_reg_write(&can->filter[b].FR2, slot[2] | (slot[3] << 16));
     }
     odo_reg_modify(&can->FM1R, 0U, bank_mask);
     odo_reg_modify(&can->FS1R, bank_mask, 0U);
     odo_reg_modify(&can->FFA1R, bank_mask, 0U);
-    odo_reg_modify(&can->FA1R, (1UL << ODO_CAN_FILTER_BANKS) - 1U, bank_mask);
+    odo_reg_modify(&can->FA1R, (1U << ODO_CAN_FILTER_BANKS) - 1U, bank_mask);
     odo_reg_modify(&can->FMR, ODO_CAN_FMR_FINIT, 0U);
 
     odo_reg_modify(&can->MCR, ODO_CAN_MCR_INRQ, 0U);
@@ -106,7 +106,7 @@ bool odo_bxcan_send(odo_stm32_can_t *can, const odo_can_frame_t *f)
         }
         odo_stm32_can_tx_t *mb = &can->tx[m];
         const bool ext = (f->flags & ODO_CAN_FLAG_EXT) != 0U;
-        uint32_t tir = ext ? ((f->id & 0x1FFFFFFFUL) << 3) | ODO_CAN_XIR_IDE : (f->id & 0x7FFUL) << 21;
+        uint32_t tir = ext ? ((f->id & 0x1FFFFFFFU) << 3) | ODO_CAN_XIR_IDE : (f->id & 0x7FFU) << 21;
         if ((f->flags & ODO_CAN_FLAG_RTR) != 0U) {
             tir |= ODO_CAN_XIR_RTR;
         }
@@ -143,9 +143,9 @@ bool odo_bxcan_recv(odo_stm32_can_t *can, odo_can_frame_t *f, uint8_t *raw_dlc, 
     memset(f, 0, sizeof *f);
     if ((rir & ODO_CAN_XIR_IDE) != 0U) {
         f->flags |= ODO_CAN_FLAG_EXT;
-        f->id = (rir >> 3) & 0x1FFFFFFFUL;
+        f->id = (rir >> 3) & 0x1FFFFFFFU;
     } else {
-        f->id = (rir >> 21) & 0x7FFUL;
+        f->id = (rir >> 21) & 0x7FFU;
     }
     if ((rir & ODO_CAN_XIR_RTR) != 0U) {
         f->flags |= ODO_CAN_FLAG_RTR;
@@ -160,7 +160,4 @@ bool odo_bxcan_recv(odo_stm32_can_t *can, odo_can_frame_t *f, uint8_t *raw_dlc, 
     return true;
 }
 
-bool odo_bxcan_bus_off(odo_stm32_can_t *can)
-{
-    return (odo_reg_read(&can->ESR) & ODO_CAN_ESR_BOFF) != 0U;
-}
+bool odo_bxcan_bus_off(odo_stm32_can_t *can) { return (odo_reg_read(&can->ESR) & ODO_CAN_ESR_BOFF) != 0U; }

@@ -28,9 +28,9 @@ extern "C" {
 
 typedef enum {
     ODO_BXCAN_OK = 0,
-    ODO_BXCAN_ERR_BITRATE,   ///< no exact timing for this bit rate at this APB1 clock
-    ODO_BXCAN_ERR_IDS,       ///< no identifiers, too many, or one above 0x7FF
-    ODO_BXCAN_ERR_INIT_MODE, ///< the controller did not enter initialisation mode
+    ODO_BXCAN_ERR_BITRATE,    ///< no exact timing for this bit rate at this APB1 clock
+    ODO_BXCAN_ERR_IDS,        ///< no identifiers, too many, or one above 0x7FF
+    ODO_BXCAN_ERR_INIT_MODE,  ///< the controller did not enter initialisation mode
     ODO_BXCAN_ERR_NORMAL_MODE ///< ... or did not leave it (no 11 recessive bits: bus stuck)
 } odo_bxcan_status_t;
 
@@ -39,8 +39,8 @@ typedef enum {
 bool odo_bxcan_timing(uint32_t pclk1_hz, uint32_t bitrate, uint32_t *btr, uint32_t *sample_permille);
 
 /// Initialise: init mode, timing, filters for ids[0..n_ids), normal mode.
-odo_bxcan_status_t odo_bxcan_init(odo_stm32_can_t *can, uint32_t pclk1_hz, uint32_t bitrate,
-                                  const uint32_t *ids, uint8_t n_ids, uint32_t polls);
+odo_bxcan_status_t odo_bxcan_init(odo_stm32_can_t *can, uint32_t pclk1_hz, uint32_t bitrate, const uint32_t *ids,
+                                  uint8_t n_ids, uint32_t polls);
 
 /// Queue a frame in a free mailbox. Returns false iff all three are busy or the frame is not a
 /// classic data or remote frame (dlc > 8).

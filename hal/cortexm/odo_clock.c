@@ -3,9 +3,9 @@
 
 #include "odo_reg.h"
 
-#define PLLN 336U
-#define PLLP 2U
-#define PLLQ 7U
+#define PLLN                     336U
+#define PLLP                     2U
+#define PLLQ                     7U
 #define FLASH_WAIT_STATES_168MHZ 5U /* RM0090 3.5.1: 150 < HCLK <= 168 MHz at 2.7-3.6 V */
 
 static odo_clock_t tree(odo_clock_source_t source, uint32_t sysclk_hz, int divided)
@@ -20,8 +20,7 @@ static odo_clock_t tree(odo_clock_source_t source, uint32_t sysclk_hz, int divid
     return c;
 }
 
-odo_clock_t odo_clock_init(odo_stm32_rcc_t *rcc, odo_stm32_flash_t *flash, uint32_t hse_hz,
-                           uint32_t polls)
+odo_clock_t odo_clock_init(odo_stm32_rcc_t *rcc, odo_stm32_flash_t *flash, uint32_t hse_hz, uint32_t polls)
 {
     /* Start from the reset state: on HSI, PLL off (it cannot be reconfigured while on). */
     odo_reg_modify(&rcc->CR, 0U, ODO_RCC_CR_HSION);
@@ -30,15 +29,15 @@ odo_clock_t odo_clock_init(odo_stm32_rcc_t *rcc, odo_stm32_flash_t *flash, uint3
     odo_reg_modify(&rcc->CR, ODO_RCC_CR_PLLON, 0U);
 
     int use_hse = 0;
-    const uint32_t hse_mhz = hse_hz / 1000000UL;
-    if (hse_mhz >= 4U && hse_mhz <= 26U && hse_mhz * 1000000UL == hse_hz) {
+    const uint32_t hse_mhz = hse_hz / 1000000U;
+    if (hse_mhz >= 4U && hse_mhz <= 26U && hse_mhz * 1000000U == hse_hz) {
         odo_reg_modify(&rcc->CR, ODO_RCC_CR_HSEBYP, ODO_RCC_CR_HSEON);
         use_hse = odo_reg_wait(&rcc->CR, ODO_RCC_CR_HSERDY, ODO_RCC_CR_HSERDY, polls);
         if (!use_hse) {
             odo_reg_modify(&rcc->CR, ODO_RCC_CR_HSEON, 0U); /* no crystal: stop trying */
         }
     }
-    const uint32_t pllm = use_hse ? hse_mhz : ODO_CLOCK_HSI_HZ / 1000000UL;
+    const uint32_t pllm = use_hse ? hse_mhz : ODO_CLOCK_HSI_HZ / 1000000U;
     odo_reg_write(&rcc->PLLCFGR, ODO_RCC_PLLCFGR(pllm, PLLN, PLLP, use_hse, PLLQ));
     odo_reg_modify(&rcc->CR, 0U, ODO_RCC_CR_PLLON);
     if (!odo_reg_wait(&rcc->CR, ODO_RCC_CR_PLLRDY, ODO_RCC_CR_PLLRDY, polls)) {
@@ -47,8 +46,7 @@ odo_clock_t odo_clock_init(odo_stm32_rcc_t *rcc, odo_stm32_flash_t *flash, uint3
     }
     /* Wait states before the clock goes up, prescalers before the switch. */
     odo_reg_modify(&flash->ACR, ODO_FLASH_ACR_LATENCY_MASK,
-                   FLASH_WAIT_STATES_168MHZ | ODO_FLASH_ACR_PRFTEN | ODO_FLASH_ACR_ICEN |
-                       ODO_FLASH_ACR_DCEN);
+                   FLASH_WAIT_STATES_168MHZ | ODO_FLASH_ACR_PRFTEN | ODO_FLASH_ACR_ICEN | ODO_FLASH_ACR_DCEN);
     odo_reg_modify(&rcc->CFGR, ODO_RCC_CFGR_HPRE_MASK | ODO_RCC_CFGR_PPRE1_MASK | ODO_RCC_CFGR_PPRE2_MASK,
                    ODO_RCC_CFGR_PPRE1_DIV4 | ODO_RCC_CFGR_PPRE2_DIV2);
     odo_reg_modify(&rcc->CFGR, ODO_RCC_CFGR_SW_MASK, ODO_RCC_CFGR_SW_PLL);

@@ -21,29 +21,28 @@
 extern "C" {
 #endif
 
-#define ODO_CLOCK_HSI_HZ    16000000UL
-#define ODO_CLOCK_TARGET_HZ 168000000UL
+#define ODO_CLOCK_HSI_HZ    16000000U
+#define ODO_CLOCK_TARGET_HZ 168000000U
 
 typedef enum {
     ODO_CLOCK_HSE_PLL = 0, ///< 168 MHz from the crystal (the normal case)
     ODO_CLOCK_HSI_PLL = 1, ///< 168 MHz from the internal RC: no crystal (CAN timing is less exact)
-    ODO_CLOCK_HSI     = 2  ///< 16 MHz: the PLL did not lock; everything runs, slowly
+    ODO_CLOCK_HSI = 2      ///< 16 MHz: the PLL did not lock; everything runs, slowly
 } odo_clock_source_t;
 
 typedef struct {
     odo_clock_source_t source;
     uint32_t sysclk_hz;
     uint32_t hclk_hz;
-    uint32_t pclk1_hz;      ///< APB1: bxCAN, TIM2-7
+    uint32_t pclk1_hz; ///< APB1: bxCAN, TIM2-7
     uint32_t pclk2_hz;
-    uint32_t tim_apb1_hz;   ///< TIM2-7 kernel clock: pclk1, doubled when APB1 is divided
+    uint32_t tim_apb1_hz; ///< TIM2-7 kernel clock: pclk1, doubled when APB1 is divided
 } odo_clock_t;
 
 /// Configure the clocks as above. hse_hz: the board's crystal, a whole number of MHz in [4, 26]
 /// (0: no crystal fitted, go straight to HSI). Returns the clock tree actually running. Bounded:
 /// at most 4 * polls register reads.
-odo_clock_t odo_clock_init(odo_stm32_rcc_t *rcc, odo_stm32_flash_t *flash, uint32_t hse_hz,
-                           uint32_t polls);
+odo_clock_t odo_clock_init(odo_stm32_rcc_t *rcc, odo_stm32_flash_t *flash, uint32_t hse_hz, uint32_t polls);
 
 #ifdef __cplusplus
 }

@@ -3,22 +3,16 @@
 
 #include "odo_reg.h"
 
-#define DATA_MODER_MASK 0xFFFFUL  /* pins 0-7, two bits each */
-#define DATA_MODER_OUT  0x5555UL  /* 01 = general-purpose output */
+#define DATA_MODER_MASK 0xFFFFU /* pins 0-7, two bits each */
+#define DATA_MODER_OUT  0x5555U /* 01 = general-purpose output */
 
-static void pin_high(odo_stm32_gpio_t *g, uint8_t pin)
-{
-    odo_reg_write(&g->BSRR, 1UL << pin);
-}
+static void pin_high(odo_stm32_gpio_t *g, uint8_t pin) { odo_reg_write(&g->BSRR, (uint32_t)1U << pin); }
 
-static void pin_low(odo_stm32_gpio_t *g, uint8_t pin)
-{
-    odo_reg_write(&g->BSRR, 1UL << (16U + pin));
-}
+static void pin_low(odo_stm32_gpio_t *g, uint8_t pin) { odo_reg_write(&g->BSRR, (uint32_t)1U << (16U + pin)); }
 
 static void pin_output(odo_stm32_gpio_t *g, uint8_t pin)
 {
-    odo_reg_modify(&g->MODER, 3UL << (2U * pin), (uint32_t)ODO_GPIO_MODE_OUTPUT << (2U * pin));
+    odo_reg_modify(&g->MODER, (uint32_t)3U << (2U * pin), (uint32_t)ODO_GPIO_MODE_OUTPUT << (2U * pin));
 }
 
 void odo_hctl_bus_init(const odo_hctl_bus_t *bus)

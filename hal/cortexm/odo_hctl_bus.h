@@ -33,14 +33,14 @@ extern "C" {
 #define ODO_HCTL_BITS 24U
 
 typedef struct {
-    odo_stm32_gpio_t *data;      ///< D0-D7 on pins 0-7
-    odo_stm32_gpio_t *ctrl;      ///< ALE, /OE, R/W and the /CS lines
-    uint8_t           ale_pin;
-    uint8_t           oe_pin;
-    uint8_t           rw_pin;
-    uint8_t           cs_pin[ODO_HCTL_MAX_CHIPS];
-    uint8_t           chips;     ///< 1..ODO_HCTL_MAX_CHIPS
-    uint32_t          settle_loops; ///< busy-wait iterations between /OE low and the IDR read
+    odo_stm32_gpio_t *data; ///< D0-D7 on pins 0-7
+    odo_stm32_gpio_t *ctrl; ///< ALE, /OE, R/W and the /CS lines
+    uint8_t ale_pin;
+    uint8_t oe_pin;
+    uint8_t rw_pin;
+    uint8_t cs_pin[ODO_HCTL_MAX_CHIPS];
+    uint8_t chips;         ///< 1..ODO_HCTL_MAX_CHIPS
+    uint32_t settle_loops; ///< busy-wait iterations between /OE low and the IDR read
 } odo_hctl_bus_t;
 
 /// Idle levels (/CS, /OE high, ALE low, R/W high), control pins as outputs, data pins as inputs.

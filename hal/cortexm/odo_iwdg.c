@@ -9,9 +9,10 @@ bool odo_iwdg_config(uint32_t timeout_ms, uint32_t *pr, uint32_t *rlr)
         return false;
     }
     for (uint32_t p = 0U; p <= 6U; ++p) {
-        const uint32_t div = 4UL << p;
+        const uint32_t div = (uint32_t)4U << p;
         /* ticks = timeout * LSI / div, rounded; the counter runs RLR + 1 ticks. */
-        const uint32_t ticks = (uint32_t)(((uint64_t)timeout_ms * ODO_IWDG_LSI_HZ + 500U * div) / (1000U * div));
+        const uint32_t ticks =
+            (uint32_t)(((uint64_t)timeout_ms * ODO_IWDG_LSI_HZ + 500U * (uint64_t)div) / (1000U * (uint64_t)div));
         if (ticks >= 1U && ticks <= 4096U) {
             *pr = p;
             *rlr = ticks - 1U;
@@ -31,12 +32,9 @@ bool odo_iwdg_start(odo_stm32_iwdg_t *iwdg, uint32_t timeout_ms, uint32_t polls)
     odo_reg_write(&iwdg->KR, ODO_IWDG_KEY_UNLOCK);
     odo_reg_write(&iwdg->PR, pr);
     odo_reg_write(&iwdg->RLR, rlr);
-    const bool ok = odo_reg_wait(&iwdg->SR, 3UL, 0UL, polls) != 0; /* PVU, RVU cleared */
+    const bool ok = odo_reg_wait(&iwdg->SR, 3U, 0U, polls) != 0; /* PVU, RVU cleared */
     odo_reg_write(&iwdg->KR, ODO_IWDG_KEY_RELOAD);
     return ok;
 }
 
-void odo_iwdg_refresh(odo_stm32_iwdg_t *iwdg)
-{
-    odo_reg_write(&iwdg->KR, ODO_IWDG_KEY_RELOAD);
-}
+void odo_iwdg_refresh(odo_stm32_iwdg_t *iwdg) { odo_reg_write(&iwdg->KR, ODO_IWDG_KEY_RELOAD); }

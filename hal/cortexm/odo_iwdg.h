@@ -16,7 +16,7 @@
 extern "C" {
 #endif
 
-#define ODO_IWDG_LSI_HZ 32000UL
+#define ODO_IWDG_LSI_HZ 32000U
 
 /// Prescaler and reload for a nominal timeout_ms (1..32768): the smallest prescaler 4 * 2^PR
 /// whose 12-bit reload can hold it. Returns false iff out of range.

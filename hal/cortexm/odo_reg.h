@@ -17,15 +17,9 @@ extern "C" {
 uint32_t odo_reg_read(const volatile uint32_t *reg);
 void odo_reg_write(volatile uint32_t *reg, uint32_t value);
 #else
-static inline uint32_t odo_reg_read(const volatile uint32_t *reg)
-{
-    return *reg;
-}
+static inline uint32_t odo_reg_read(const volatile uint32_t *reg) { return *reg; }
 
-static inline void odo_reg_write(volatile uint32_t *reg, uint32_t value)
-{
-    *reg = value;
-}
+static inline void odo_reg_write(volatile uint32_t *reg, uint32_t value) { *reg = value; }
 #endif
 
 /// Read-modify-write: clear `clear`, then set `set`. Not atomic; the drivers call it from the
@@ -36,8 +30,7 @@ static inline void odo_reg_modify(volatile uint32_t *reg, uint32_t clear, uint32
 }
 
 /// Poll until (reg & mask) == want, at most `polls` reads. Returns true iff it got there.
-static inline int odo_reg_wait(const volatile uint32_t *reg, uint32_t mask, uint32_t want,
-                               uint32_t polls)
+static inline int odo_reg_wait(const volatile uint32_t *reg, uint32_t mask, uint32_t want, uint32_t polls)
 {
     for (uint32_t i = 0U; i < polls; ++i) {
         if ((odo_reg_read(reg) & mask) == want) {

@@ -13,22 +13,24 @@ static const int16_t k_synthetic_deltas[][2] = {
 #define ODO_SELFTEST_TICKS (sizeof k_synthetic_deltas / sizeof k_synthetic_deltas[0])
 
 /// Counters start just below the 24-bit wrap, so the run also crosses a counter wrap.
-#define ODO_SELFTEST_START_RAW 0x00FFFF80UL
+#define ODO_SELFTEST_START_RAW 0x00FFFF80U
 #define ODO_SELFTEST_BITS      24U
 #define ODO_SELFTEST_TICK_US   40000U
 
-void odo_selftest_run(odo_app_t *app, odo_tick_input_t *in, odo_tick_output_t *out,
-                      const uint8_t *block, size_t len, odo_board_selftest_t *r)
+void odo_selftest_run(odo_app_t *app, odo_tick_input_t *in, odo_tick_output_t *out, const uint8_t *block, size_t len,
+                      odo_board_selftest_t *r)
 {
     memset(r, 0, sizeof *r);
     r->params_status = (uint32_t)odo_app_init(app, block, len);
 
-    const uint32_t mask = (1UL << ODO_SELFTEST_BITS) - 1UL;
+    const uint32_t mask = (1U << ODO_SELFTEST_BITS) - 1U;
     uint32_t left_raw = ODO_SELFTEST_START_RAW;
     uint32_t right_raw = ODO_SELFTEST_START_RAW;
     for (uint32_t i = 0U; i < ODO_SELFTEST_TICKS; ++i) {
-        left_raw = (left_raw + (uint32_t)(int32_t)k_synthetic_deltas[i][0]) & mask;
-        right_raw = (right_raw + (uint32_t)(int32_t)k_synthetic_deltas[i][1]) & mask;
+        const uint32_t dl = (uint32_t)(int32_t)k_synthetic_deltas[i][0];
+        const uint32_t dr = (uint32_t)(int32_t)k_synthetic_deltas[i][1];
+        left_raw = (uint32_t)(left_raw + dl) & mask;
+        right_raw = (uint32_t)(right_raw + dr) & mask;
 
         memset(in, 0, sizeof *in);
         in->t_us = (uint64_t)(i + 1U) * ODO_SELFTEST_TICK_US;

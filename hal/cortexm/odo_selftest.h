@@ -21,21 +21,21 @@ typedef struct {
     uint32_t steps;         ///< synthetic ticks run through odo_app_step
     uint32_t faults_or;     ///< OR of the ODO_FAULT_* bits every step raised
     uint32_t frames;        ///< output frames produced in total
-    int64_t  x_mm_q32;      ///< final pose of truck A (odo_pose_t units)
-    int64_t  y_mm_q32;
-    uint32_t heading_bam;   ///< top 32 bits of the final heading_q64 of truck A
-    uint32_t done;          ///< ODO_BOARD_SELFTEST_DONE when the above are complete
+    int64_t x_mm_q32;       ///< final pose of truck A (odo_pose_t units)
+    int64_t y_mm_q32;
+    uint32_t heading_bam; ///< top 32 bits of the final heading_q64 of truck A
+    uint32_t done;        ///< ODO_BOARD_SELFTEST_DONE when the above are complete
 } odo_board_selftest_t;
 
-#define ODO_BOARD_SELFTEST_DONE 0x600DF00DUL
+#define ODO_BOARD_SELFTEST_DONE 0x600DF00DU
 
 /// Boot *app on block[0..len) (odo_app_init: defaults and a fault flag if the block is bad), run
 /// ODO_SELFTEST_TICKS synthetic ticks of truck A (straight, left and right turns, a stop, and a
 /// 24-bit counter wrap) and fill *r. *app is left booted on the block with the synthetic run in
 /// its state: the caller re-initialises it before real use. *in and *out are scratch (static on
 /// the target, so the stack holds only call frames). Constant time; no side effects elsewhere.
-void odo_selftest_run(odo_app_t *app, odo_tick_input_t *in, odo_tick_output_t *out,
-                      const uint8_t *block, size_t len, odo_board_selftest_t *r);
+void odo_selftest_run(odo_app_t *app, odo_tick_input_t *in, odo_tick_output_t *out, const uint8_t *block, size_t len,
+                      odo_board_selftest_t *r);
 
 #ifdef __cplusplus
 }

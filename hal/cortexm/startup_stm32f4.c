@@ -4,6 +4,7 @@
 /// is needed: Reset_Handler copies .data from flash, zeroes .bss and calls main(). The FPU is left
 /// off: the image is integer-only (soft-float ABI; the ctest firmware.cm4_image proves that no
 /// floating-point code is linked), and newlib's crt0 is not used (-nostartfiles).
+#include <stddef.h>
 #include <stdint.h>
 
 #include "odo_board.h"
@@ -15,10 +16,14 @@
 typedef void (*odo_isr_t)(void);
 
 /// Layout fixed by the Armv7-M architecture: initial SP, then 15 system exceptions, then IRQs.
+/// The core reads every member at reset and on exceptions; C never does (hence the cppcheck notes).
 typedef struct {
+    // cppcheck-suppress unusedStructMember ; read by the core at reset
     const uint32_t *initial_sp;
-    odo_isr_t       exception[15]; ///< Reset (1) .. SysTick (15)
-    odo_isr_t       irq[ODO_BOARD_IRQ_COUNT];
+    // cppcheck-suppress unusedStructMember ; read by the core on each exception
+    odo_isr_t exception[15]; ///< Reset (1) .. SysTick (15)
+    // cppcheck-suppress unusedStructMember ; read by the NVIC on each interrupt
+    odo_isr_t irq[ODO_BOARD_IRQ_COUNT];
 } odo_vector_table_t;
 
 // Provided by odo_cm4.ld.
@@ -39,48 +44,53 @@ void DebugMon_Handler(void) __attribute__((weak, alias("Default_Handler")));
 void PendSV_Handler(void) __attribute__((weak, alias("Default_Handler")));
 void SysTick_Handler(void) __attribute__((weak, alias("Default_Handler")));
 
-#define ODO_H1 Default_Handler
-#define ODO_H2 ODO_H1, ODO_H1
-#define ODO_H4 ODO_H2, ODO_H2
-#define ODO_H8 ODO_H4, ODO_H4
+#define ODO_H1  Default_Handler
+#define ODO_H2  ODO_H1, ODO_H1
+#define ODO_H4  ODO_H2, ODO_H2
+#define ODO_H8  ODO_H4, ODO_H4
 #define ODO_H16 ODO_H8, ODO_H8
 #define ODO_H32 ODO_H16, ODO_H16
 #define ODO_H64 ODO_H32, ODO_H32
 
 /// Placed first in flash by odo_cm4.ld (section .isr_vector, KEEP).
-__attribute__((section(".isr_vector"), used))
-static const odo_vector_table_t odo_vector_table = {
+__attribute__((section(".isr_vector"), used)) static const odo_vector_table_t odo_vector_table = {
     .initial_sp = _estack,
-    .exception = {
-        Reset_Handler,
-        NMI_Handler,
-        HardFault_Handler,
-        MemManage_Handler,
-        BusFault_Handler,
-        UsageFault_Handler,
-        0, 0, 0, 0, // reserved
-        SVC_Handler,
-        DebugMon_Handler,
-        0, // reserved
-        PendSV_Handler,
-        SysTick_Handler,
-    },
+    .exception =
+        {
+            Reset_Handler,
+            NMI_Handler,
+            HardFault_Handler,
+            MemManage_Handler,
+            BusFault_Handler,
+            UsageFault_Handler,
+            0,
+            0,
+            0,
+            0, // reserved
+            SVC_Handler,
+            DebugMon_Handler,
+            0, // reserved
+            PendSV_Handler,
+            SysTick_Handler,
+        },
     // No peripheral interrupt is enabled yet; every line traps in Default_Handler.
-    .irq = { ODO_H64, ODO_H16, ODO_H2 },
+    .irq = {ODO_H64, ODO_H16, ODO_H2},
 };
 
 /// C99 static assert: the vector table must be a packed array of 32-bit words.
-typedef char odo_vector_table_is_packed[
-    (sizeof(odo_vector_table_t) == 4U * (16U + ODO_BOARD_IRQ_COUNT)) ? 1 : -1];
+typedef char odo_vector_table_is_packed[(sizeof(odo_vector_table_t) == 4U * (16U + ODO_BOARD_IRQ_COUNT)) ? 1 : -1];
 
 void Reset_Handler(void)
 {
-    const uint32_t *src = _sidata;
-    for (uint32_t *dst = _sdata; dst < _edata; ++dst, ++src) {
-        *dst = *src;
+    /* Word counts from the linker symbols' addresses: comparing pointers into different
+     * objects (dst < _edata) is undefined in C, and cppcheck says so. */
+    const size_t data_words = ((uintptr_t)_edata - (uintptr_t)_sdata) / sizeof(uint32_t);
+    const size_t bss_words = ((uintptr_t)_ebss - (uintptr_t)_sbss) / sizeof(uint32_t);
+    for (size_t i = 0U; i < data_words; ++i) {
+        _sdata[i] = _sidata[i];
     }
-    for (uint32_t *dst = _sbss; dst < _ebss; ++dst) {
-        *dst = 0U;
+    for (size_t i = 0U; i < bss_words; ++i) {
+        _sbss[i] = 0U;
     }
     (void)main();
     for (;;) {

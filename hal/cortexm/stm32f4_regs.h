@@ -19,53 +19,53 @@ typedef volatile uint32_t odo_reg32_t;
  *      section 'RCC registers' (register map at its end); cited by register name below, since the
  *      chapter's number differs between manual revisions. ----------------------------------------- */
 typedef struct {
-    odo_reg32_t CR;         ///< 0x00 RCC_CR, clock control
-    odo_reg32_t PLLCFGR;    ///< 0x04 RCC_PLLCFGR, PLL configuration
-    odo_reg32_t CFGR;       ///< 0x08 RCC_CFGR, clock configuration
-    odo_reg32_t CIR;        ///< 0x0C clock interrupt
-    odo_reg32_t AHB1RSTR;   ///< 0x10
-    odo_reg32_t AHB2RSTR;   ///< 0x14
-    odo_reg32_t AHB3RSTR;   ///< 0x18
-    odo_reg32_t reserved0;  ///< 0x1C
-    odo_reg32_t APB1RSTR;   ///< 0x20
-    odo_reg32_t APB2RSTR;   ///< 0x24
+    odo_reg32_t CR;        ///< 0x00 RCC_CR, clock control
+    odo_reg32_t PLLCFGR;   ///< 0x04 RCC_PLLCFGR, PLL configuration
+    odo_reg32_t CFGR;      ///< 0x08 RCC_CFGR, clock configuration
+    odo_reg32_t CIR;       ///< 0x0C clock interrupt
+    odo_reg32_t AHB1RSTR;  ///< 0x10
+    odo_reg32_t AHB2RSTR;  ///< 0x14
+    odo_reg32_t AHB3RSTR;  ///< 0x18
+    odo_reg32_t reserved0; ///< 0x1C
+    odo_reg32_t APB1RSTR;  ///< 0x20
+    odo_reg32_t APB2RSTR;  ///< 0x24
     odo_reg32_t reserved1[2];
-    odo_reg32_t AHB1ENR;    ///< 0x30 RCC_AHB1ENR, AHB1 peripheral clock enable
-    odo_reg32_t AHB2ENR;    ///< 0x34
-    odo_reg32_t AHB3ENR;    ///< 0x38
-    odo_reg32_t reserved2;  ///< 0x3C
-    odo_reg32_t APB1ENR;    ///< 0x40 RCC_APB1ENR
-    odo_reg32_t APB2ENR;    ///< 0x44 RCC_APB2ENR
+    odo_reg32_t AHB1ENR;   ///< 0x30 RCC_AHB1ENR, AHB1 peripheral clock enable
+    odo_reg32_t AHB2ENR;   ///< 0x34
+    odo_reg32_t AHB3ENR;   ///< 0x38
+    odo_reg32_t reserved2; ///< 0x3C
+    odo_reg32_t APB1ENR;   ///< 0x40 RCC_APB1ENR
+    odo_reg32_t APB2ENR;   ///< 0x44 RCC_APB2ENR
     odo_reg32_t reserved3[10];
-    odo_reg32_t BDCR;       ///< 0x70
-    odo_reg32_t CSR;        ///< 0x74 clock control & status (LSI for the IWDG)
+    odo_reg32_t BDCR; ///< 0x70
+    odo_reg32_t CSR;  ///< 0x74 clock control & status (LSI for the IWDG)
 } odo_stm32_rcc_t;
 
-#define ODO_RCC_CR_HSION      (1UL << 0)
-#define ODO_RCC_CR_HSIRDY     (1UL << 1)
-#define ODO_RCC_CR_HSEON      (1UL << 16)
-#define ODO_RCC_CR_HSERDY     (1UL << 17)
-#define ODO_RCC_CR_HSEBYP     (1UL << 18)
-#define ODO_RCC_CR_PLLON      (1UL << 24)
-#define ODO_RCC_CR_PLLRDY     (1UL << 25)
+#define ODO_RCC_CR_HSION  (1U << 0)
+#define ODO_RCC_CR_HSIRDY (1U << 1)
+#define ODO_RCC_CR_HSEON  (1U << 16)
+#define ODO_RCC_CR_HSERDY (1U << 17)
+#define ODO_RCC_CR_HSEBYP (1U << 18)
+#define ODO_RCC_CR_PLLON  (1U << 24)
+#define ODO_RCC_CR_PLLRDY (1U << 25)
 /* PLLCFGR: PLLM[5:0], PLLN[14:6], PLLP[17:16] (00: /2), PLLSRC[22] (1: HSE), PLLQ[27:24]. */
-#define ODO_RCC_PLLCFGR(m, n, p_div, src_hse, q) \
-    ((uint32_t)(m) | ((uint32_t)(n) << 6) | ((uint32_t)(((p_div) / 2U) - 1U) << 16) | \
-     ((src_hse) ? (1UL << 22) : 0UL) | ((uint32_t)(q) << 24))
+#define ODO_RCC_PLLCFGR(m, n, p_div, src_hse, q)                                                                      \
+    ((uint32_t)(m) | ((uint32_t)(n) << 6) | ((uint32_t)(((p_div) / 2U) - 1U) << 16) | ((src_hse) ? (1U << 22) : 0U) | \
+     ((uint32_t)(q) << 24))
 /* CFGR: SW[1:0], SWS[3:2] (00 HSI, 01 HSE, 10 PLL), HPRE[7:4], PPRE1[12:10], PPRE2[15:13]. */
-#define ODO_RCC_CFGR_SW_MASK   (3UL << 0)
-#define ODO_RCC_CFGR_SWS_MASK  (3UL << 2)
-#define ODO_RCC_CFGR_SW_HSI    0UL
-#define ODO_RCC_CFGR_SW_HSE    1UL
-#define ODO_RCC_CFGR_SW_PLL    2UL
-#define ODO_RCC_CFGR_SWS(sw)   ((uint32_t)(sw) << 2)
-#define ODO_RCC_CFGR_HPRE_MASK  (0xFUL << 4)
-#define ODO_RCC_CFGR_PPRE1_MASK (7UL << 10)
-#define ODO_RCC_CFGR_PPRE2_MASK (7UL << 13)
-#define ODO_RCC_CFGR_PPRE1_DIV4 (5UL << 10)
-#define ODO_RCC_CFGR_PPRE2_DIV2 (4UL << 13)
-#define ODO_RCC_CSR_LSION     (1UL << 0)
-#define ODO_RCC_CSR_LSIRDY    (1UL << 1)
+#define ODO_RCC_CFGR_SW_MASK    (3U << 0)
+#define ODO_RCC_CFGR_SWS_MASK   (3U << 2)
+#define ODO_RCC_CFGR_SW_HSI     0U
+#define ODO_RCC_CFGR_SW_HSE     1U
+#define ODO_RCC_CFGR_SW_PLL     2U
+#define ODO_RCC_CFGR_SWS(sw)    ((uint32_t)(sw) << 2)
+#define ODO_RCC_CFGR_HPRE_MASK  (0xFU << 4)
+#define ODO_RCC_CFGR_PPRE1_MASK (7U << 10)
+#define ODO_RCC_CFGR_PPRE2_MASK (7U << 13)
+#define ODO_RCC_CFGR_PPRE1_DIV4 (5U << 10)
+#define ODO_RCC_CFGR_PPRE2_DIV2 (4U << 13)
+#define ODO_RCC_CSR_LSION       (1U << 0)
+#define ODO_RCC_CSR_LSIRDY      (1U << 1)
 
 /* ---- Embedded flash interface: RM0090 section 3.9 (FLASH_ACR 3.9.1), wait states 3.5.1 ------- */
 typedef struct {
@@ -77,10 +77,10 @@ typedef struct {
     odo_reg32_t OPTCR;
 } odo_stm32_flash_t;
 
-#define ODO_FLASH_ACR_LATENCY_MASK 7UL
-#define ODO_FLASH_ACR_PRFTEN (1UL << 8)
-#define ODO_FLASH_ACR_ICEN   (1UL << 9)
-#define ODO_FLASH_ACR_DCEN   (1UL << 10)
+#define ODO_FLASH_ACR_LATENCY_MASK 7U
+#define ODO_FLASH_ACR_PRFTEN       (1U << 8)
+#define ODO_FLASH_ACR_ICEN         (1U << 9)
+#define ODO_FLASH_ACR_DCEN         (1U << 10)
 
 /* ---- GPIO: RM0090 section 8.4 (GPIO registers), map in 8.4.11 -------------------------------- */
 typedef struct {
@@ -118,21 +118,21 @@ typedef struct {
     odo_reg32_t reserved0;
     odo_reg32_t CCR[4]; ///< 0x34..0x40
     odo_reg32_t reserved1;
-    odo_reg32_t DCR;   ///< 0x48
-    odo_reg32_t DMAR;  ///< 0x4C
-    odo_reg32_t OR;    ///< 0x50
+    odo_reg32_t DCR;  ///< 0x48
+    odo_reg32_t DMAR; ///< 0x4C
+    odo_reg32_t OR;   ///< 0x50
 } odo_stm32_tim_t;
 
-#define ODO_TIM_CR1_CEN  (1UL << 0)
-#define ODO_TIM_CR1_URS  (1UL << 2)
-#define ODO_TIM_DIER_UIE (1UL << 0)
-#define ODO_TIM_SR_UIF   (1UL << 0)
-#define ODO_TIM_EGR_UG   (1UL << 0)
-#define ODO_TIM_SMCR_SMS_ENCODER3 3UL
-#define ODO_TIM_CCMR1_CC1S_TI1 (1UL << 0)
-#define ODO_TIM_CCMR1_CC2S_TI2 (1UL << 8)
-#define ODO_TIM_CCMR1_IC1F(f) ((uint32_t)(f) << 4)
-#define ODO_TIM_CCMR1_IC2F(f) ((uint32_t)(f) << 12)
+#define ODO_TIM_CR1_CEN           (1U << 0)
+#define ODO_TIM_CR1_URS           (1U << 2)
+#define ODO_TIM_DIER_UIE          (1U << 0)
+#define ODO_TIM_SR_UIF            (1U << 0)
+#define ODO_TIM_EGR_UG            (1U << 0)
+#define ODO_TIM_SMCR_SMS_ENCODER3 3U
+#define ODO_TIM_CCMR1_CC1S_TI1    (1U << 0)
+#define ODO_TIM_CCMR1_CC2S_TI2    (1U << 8)
+#define ODO_TIM_CCMR1_IC1F(f)     ((uint32_t)(f) << 4)
+#define ODO_TIM_CCMR1_IC2F(f)     ((uint32_t)(f) << 12)
 
 /* ---- bxCAN: RM0090 section 32.9 (CAN registers), map 32.9.5 ---------------------------------- */
 typedef struct {
@@ -179,22 +179,22 @@ typedef struct {
     odo_stm32_can_filter_t filter[28]; ///< 0x240
 } odo_stm32_can_t;
 
-#define ODO_CAN_MCR_INRQ  (1UL << 0)
-#define ODO_CAN_MCR_SLEEP (1UL << 1)
-#define ODO_CAN_MCR_TXFP  (1UL << 2)
-#define ODO_CAN_MCR_ABOM  (1UL << 6)
-#define ODO_CAN_MSR_INAK  (1UL << 0)
-#define ODO_CAN_MSR_SLAK  (1UL << 1)
-#define ODO_CAN_TSR_TME(n) (1UL << (26U + (n)))
-#define ODO_CAN_RF0R_FMP0_MASK 3UL
-#define ODO_CAN_RF0R_FOVR0 (1UL << 4)
-#define ODO_CAN_RF0R_RFOM0 (1UL << 5)
-#define ODO_CAN_ESR_BOFF  (1UL << 2)
-#define ODO_CAN_TIR_TXRQ  (1UL << 0)
-#define ODO_CAN_XIR_RTR   (1UL << 1)
-#define ODO_CAN_XIR_IDE   (1UL << 2)
-#define ODO_CAN_FMR_FINIT (1UL << 0)
-#define ODO_CAN_FILTER_BANKS 14U ///< banks of CAN1 with the reset CAN2SB (32.7.4)
+#define ODO_CAN_MCR_INRQ       (1U << 0)
+#define ODO_CAN_MCR_SLEEP      (1U << 1)
+#define ODO_CAN_MCR_TXFP       (1U << 2)
+#define ODO_CAN_MCR_ABOM       (1U << 6)
+#define ODO_CAN_MSR_INAK       (1U << 0)
+#define ODO_CAN_MSR_SLAK       (1U << 1)
+#define ODO_CAN_TSR_TME(n)     (1U << (26U + (n)))
+#define ODO_CAN_RF0R_FMP0_MASK 3U
+#define ODO_CAN_RF0R_FOVR0     (1U << 4)
+#define ODO_CAN_RF0R_RFOM0     (1U << 5)
+#define ODO_CAN_ESR_BOFF       (1U << 2)
+#define ODO_CAN_TIR_TXRQ       (1U << 0)
+#define ODO_CAN_XIR_RTR        (1U << 1)
+#define ODO_CAN_XIR_IDE        (1U << 2)
+#define ODO_CAN_FMR_FINIT      (1U << 0)
+#define ODO_CAN_FILTER_BANKS   14U ///< banks of CAN1 with the reset CAN2SB (32.7.4)
 
 /* ---- IWDG: RM0090 section 21.4 (IWDG registers), map 21.4.5 ---------------------------------- */
 typedef struct {
@@ -204,36 +204,35 @@ typedef struct {
     odo_reg32_t SR;  ///< 0x0C PVU 0, RVU 1: an update is in progress
 } odo_stm32_iwdg_t;
 
-#define ODO_IWDG_KEY_UNLOCK 0x5555UL
-#define ODO_IWDG_KEY_RELOAD 0xAAAAUL
-#define ODO_IWDG_KEY_START  0xCCCCUL
+#define ODO_IWDG_KEY_UNLOCK 0x5555U
+#define ODO_IWDG_KEY_RELOAD 0xAAAAU
+#define ODO_IWDG_KEY_START  0xCCCCU
 
 /* ---- Memory map: RM0090 section 2.3, Table 1 ------------------------------------------------- */
-#define ODO_STM32_TIM2_BASE  0x40000000UL
-#define ODO_STM32_TIM3_BASE  0x40000400UL
-#define ODO_STM32_TIM4_BASE  0x40000800UL
-#define ODO_STM32_TIM5_BASE  0x40000C00UL
-#define ODO_STM32_TIM6_BASE  0x40001000UL
-#define ODO_STM32_TIM7_BASE  0x40001400UL
-#define ODO_STM32_IWDG_BASE  0x40003000UL
-#define ODO_STM32_CAN1_BASE  0x40006400UL
-#define ODO_STM32_GPIO_BASE(port) (0x40020000UL + 0x400UL * (uint32_t)(port)) ///< A = 0 .. I = 8
-#define ODO_STM32_RCC_BASE   0x40023800UL
-#define ODO_STM32_FLASH_BASE 0x40023C00UL
+#define ODO_STM32_TIM2_BASE       0x40000000U
+#define ODO_STM32_TIM3_BASE       0x40000400U
+#define ODO_STM32_TIM4_BASE       0x40000800U
+#define ODO_STM32_TIM5_BASE       0x40000C00U
+#define ODO_STM32_TIM6_BASE       0x40001000U
+#define ODO_STM32_TIM7_BASE       0x40001400U
+#define ODO_STM32_IWDG_BASE       0x40003000U
+#define ODO_STM32_CAN1_BASE       0x40006400U
+#define ODO_STM32_GPIO_BASE(port) (0x40020000U + 0x400U * (uint32_t)(port)) ///< A = 0 .. I = 8
+#define ODO_STM32_RCC_BASE        0x40023800U
+#define ODO_STM32_FLASH_BASE      0x40023C00U
 
 /* RCC enable bits of the peripherals above (RCC_AHB1ENR, RCC_APB1ENR). */
-#define ODO_RCC_AHB1ENR_GPIO(port) (1UL << (port))
-#define ODO_RCC_APB1ENR_TIM2 (1UL << 0)
-#define ODO_RCC_APB1ENR_TIM3 (1UL << 1)
-#define ODO_RCC_APB1ENR_TIM4 (1UL << 2)
-#define ODO_RCC_APB1ENR_TIM5 (1UL << 3)
-#define ODO_RCC_APB1ENR_TIM6 (1UL << 4)
-#define ODO_RCC_APB1ENR_TIM7 (1UL << 5)
-#define ODO_RCC_APB1ENR_CAN1 (1UL << 25)
+#define ODO_RCC_AHB1ENR_GPIO(port) (1U << (port))
+#define ODO_RCC_APB1ENR_TIM2       (1U << 0)
+#define ODO_RCC_APB1ENR_TIM3       (1U << 1)
+#define ODO_RCC_APB1ENR_TIM4       (1U << 2)
+#define ODO_RCC_APB1ENR_TIM5       (1U << 3)
+#define ODO_RCC_APB1ENR_TIM6       (1U << 4)
+#define ODO_RCC_APB1ENR_TIM7       (1U << 5)
+#define ODO_RCC_APB1ENR_CAN1       (1U << 25)
 
 /* Layout checks: C99 has no _Static_assert, so a negative array size fails the build. */
-#define ODO_REG_AT(type, field, off) \
-    typedef char odo_reg_at_##type##_##field[(offsetof(type, field) == (off)) ? 1 : -1]
+#define ODO_REG_AT(type, field, off) typedef char odo_reg_at_##type##_##field[(offsetof(type, field) == (off)) ? 1 : -1]
 ODO_REG_AT(odo_stm32_rcc_t, APB1ENR, 0x40);
 ODO_REG_AT(odo_stm32_rcc_t, CSR, 0x74);
 ODO_REG_AT(odo_stm32_gpio_t, AFR, 0x20);

@@ -13,9 +13,9 @@ static const int8_t HEXV[256] = {
     ['a'] = 10, ['b'] = 11, ['c'] = 12, ['d'] = 13, ['e'] = 14, ['f'] = 15,
 };
 static const uint8_t IS_HEX[256] = {
-    ['0'] = 1, ['1'] = 1, ['2'] = 1, ['3'] = 1, ['4'] = 1, ['5'] = 1, ['6'] = 1, ['7'] = 1, ['8'] = 1,
-    ['9'] = 1, ['A'] = 1, ['B'] = 1, ['C'] = 1, ['D'] = 1, ['E'] = 1, ['F'] = 1, ['a'] = 1, ['b'] = 1,
-    ['c'] = 1, ['d'] = 1, ['e'] = 1, ['f'] = 1,
+    ['0'] = 1, ['1'] = 1, ['2'] = 1, ['3'] = 1, ['4'] = 1, ['5'] = 1, ['6'] = 1, ['7'] = 1,
+    ['8'] = 1, ['9'] = 1, ['A'] = 1, ['B'] = 1, ['C'] = 1, ['D'] = 1, ['E'] = 1, ['F'] = 1,
+    ['a'] = 1, ['b'] = 1, ['c'] = 1, ['d'] = 1, ['e'] = 1, ['f'] = 1,
 };
 
 static inline int hexval(char c)
@@ -26,9 +26,9 @@ static inline int hexval(char c)
 
 static inline int is_blank(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n'; }
 
-#define FAIL(msg)     \
-    do {              \
-        *why = (msg); \
+#define FAIL(msg)           \
+    do {                    \
+        *why = (msg);       \
         return CANDUMP_ERR; \
     } while (0)
 
@@ -99,8 +99,11 @@ candump_result_t candump_parse_line(const char *line, size_t len, candump_line_t
     p++;
     size_t n = 0U;
     while (p < end && *p != ' ') {
-        if (n >= CANDUMP_IFACE_MAX || is_blank(*p) || *p == '(' || *p == ')') {
-            FAIL("interface name must be 1 to 15 characters, without blanks or parentheses");
+        /* Printable ASCII only: a NUL or control byte would cut or garble the name the outputs
+         * carry (found by fuzz/fuzz_candump: "(1.0) \0\a0 178#..." read back as an empty name). */
+        if (n >= CANDUMP_IFACE_MAX || is_blank(*p) || *p == '(' || *p == ')' || (unsigned char)*p < 0x21U ||
+            (unsigned char)*p > 0x7EU) {
+            FAIL("interface name must be 1 to 15 printable characters, without blanks or parentheses");
         }
         out->iface[n++] = *p++;
     }
@@ -201,8 +204,7 @@ candump_result_t candump_parse_line(const char *line, size_t len, candump_line_t
                 if (nb >= 8U) {
                     FAIL("more than 8 data bytes (CAN FD?): only classic CAN is supported");
                 }
-                out->frame.data[nb++] =
-                    (uint8_t)((HEXV[(unsigned char)p[0]] << 4) | HEXV[(unsigned char)p[1]]);
+                out->frame.data[nb++] = (uint8_t)((HEXV[(unsigned char)p[0]] << 4) | HEXV[(unsigned char)p[1]]);
                 p += 2;
             } else if (p < end && *p == '.') {
                 p++; /* canplayer's optional byte separator */
@@ -211,7 +213,7 @@ candump_result_t candump_parse_line(const char *line, size_t len, candump_line_t
             }
         }
         if (p < end && !is_blank(*p)) {
-            FAIL(*p == '_' ? "CAN XL frame: only classic CAN is supported"
+            FAIL(*p == '_'         ? "CAN XL frame: only classic CAN is supported"
                  : hexval(*p) >= 0 ? "data must be hex digit pairs (odd number of digits)"
                                    : "data must be hex digit pairs");
         }

@@ -6,7 +6,7 @@
 ///   line      = "(" seconds "." fraction ")" " " iface " " frame [ " R" | " T" ]
 ///   seconds   = 1..19 decimal digits           fraction = 1..9 decimal digits (scaled to us,
 ///                                                          digits past the 6th are truncated)
-///   iface     = 1..15 characters, none of them space, tab, '(' or ')'
+///   iface     = 1..15 printable ASCII characters (0x21..0x7E), none of them '(' or ')'
 ///   frame     = sff "#" data | eff "#" data | id "#R" [dlc]
 ///   sff       = 3 hex digits, value <= 0x7FF             -> standard frame
 ///   eff       = 8 hex digits, value <= 0x1FFFFFFF        -> extended frame (ODO_CAN_FLAG_EXT)
@@ -46,10 +46,10 @@ typedef enum {
 
 /// One parsed line, as the log wrote it.
 typedef struct {
-    uint64_t        t_us;                        ///< timestamp, microseconds
-    odo_can_frame_t frame;                       ///< id without flag bits; flags ODO_CAN_FLAG_*
-    char            iface[CANDUMP_IFACE_MAX + 1]; ///< NUL-terminated
-    char            direction;                   ///< 'R', 'T', or 0 when the line has none
+    uint64_t t_us;                     ///< timestamp, microseconds
+    odo_can_frame_t frame;             ///< id without flag bits; flags ODO_CAN_FLAG_*
+    char iface[CANDUMP_IFACE_MAX + 1]; ///< NUL-terminated
+    char direction;                    ///< 'R', 'T', or 0 when the line has none
 } candump_line_t;
 
 /// Parse `len` bytes of one line (without or with its trailing newline). Returns CANDUMP_OK,

@@ -8,7 +8,7 @@
 int hal_log_open(hal_log_t *l, const char *path)
 {
     memset(l, 0, sizeof *l);
-    snprintf(l->path, sizeof l->path, "%s", strcmp(path, "-") == 0 ? "<stdin>" : path);
+    (void)snprintf(l->path, sizeof l->path, "%s", strcmp(path, "-") == 0 ? "<stdin>" : path);
     if (strcmp(path, "-") == 0) {
         l->f = stdin;
     } else {
@@ -16,12 +16,12 @@ int hal_log_open(hal_log_t *l, const char *path)
         l->own_f = true;
     }
     if (l->f == NULL) {
-        snprintf(l->err, sizeof l->err, "%s: cannot open: %s", path, strerror(errno));
+        (void)snprintf(l->err, sizeof l->err, "%s: cannot open: %s", path, strerror(errno));
         return -1;
     }
     l->buf = malloc(HAL_LOG_CHUNK);
     if (l->buf == NULL) {
-        snprintf(l->err, sizeof l->err, "%s: out of memory", path);
+        (void)snprintf(l->err, sizeof l->err, "%s: out of memory", path);
         hal_log_close(l);
         return -1;
     }
@@ -31,7 +31,7 @@ int hal_log_open(hal_log_t *l, const char *path)
 void hal_log_close(hal_log_t *l)
 {
     if (l->own_f && l->f != NULL) {
-        fclose(l->f);
+        (void)fclose(l->f);
     }
     l->f = NULL;
     free(l->buf);
@@ -57,16 +57,16 @@ static long next_line(hal_log_t *l)
             l->start = 0U;
         }
         if (l->end == HAL_LOG_CHUNK) {
-            snprintf(l->err, sizeof l->err, "%s:%llu: line longer than %u bytes", l->path,
-                     (unsigned long long)l->line_no + 1U, HAL_LOG_CHUNK);
+            (void)snprintf(l->err, sizeof l->err, "%s:%llu: line longer than %u bytes", l->path,
+                           (unsigned long long)l->line_no + 1U, HAL_LOG_CHUNK);
             return -1;
         }
         const size_t got = fread(l->buf + l->end, 1U, HAL_LOG_CHUNK - l->end, l->f);
         l->end += got;
         if (got == 0U) {
             if (ferror(l->f)) {
-                snprintf(l->err, sizeof l->err, "%s:%llu: read error: %s", l->path,
-                         (unsigned long long)l->line_no + 1U, strerror(errno));
+                (void)snprintf(l->err, sizeof l->err, "%s:%llu: read error: %s", l->path,
+                               (unsigned long long)l->line_no + 1U, strerror(errno));
                 return -1;
             }
             l->eof = true;
@@ -77,7 +77,7 @@ static long next_line(hal_log_t *l)
 hal_log_status_t hal_log_next(hal_log_t *l, candump_line_t *out)
 {
     if (l->buf == NULL) {
-        snprintf(l->err, sizeof l->err, "%s: reader not open", l->path);
+        (void)snprintf(l->err, sizeof l->err, "%s: reader not open", l->path);
         return HAL_LOG_ERROR;
     }
     for (;;) {
@@ -103,7 +103,7 @@ hal_log_status_t hal_log_next(hal_log_t *l, candump_line_t *out)
             continue;
         }
         if (r != CANDUMP_OK) {
-            snprintf(l->err, sizeof l->err, "%s:%llu: %s", l->path, (unsigned long long)l->line_no, why);
+            (void)snprintf(l->err, sizeof l->err, "%s:%llu: %s", l->path, (unsigned long long)l->line_no, why);
             return HAL_LOG_ERROR;
         }
         l->stats.frames++;
@@ -139,7 +139,7 @@ size_t candump_format_line(char *buf, uint64_t t_us, const char *iface, const od
     p += 6;
     *p++ = ')';
     *p++ = ' ';
-    for (size_t k = 0U; iface[k] != '\0' && k < CANDUMP_IFACE_MAX; ++k) {
+    for (size_t k = 0U; k < CANDUMP_IFACE_MAX && iface[k] != '\0'; ++k) {
         *p++ = iface[k];
     }
     *p++ = ' ';
@@ -156,7 +156,10 @@ size_t candump_format_line(char *buf, uint64_t t_us, const char *iface, const od
     }
     *p++ = '#';
     if ((f->flags & ODO_CAN_FLAG_RTR) != 0U) {
-        *p++ = 'R';
+        *p++ = 'R'; /* and the requested length, as can-utils writes it ("#R3"); found by fuzz_candump */
+        if (f->dlc > 0U && f->dlc <= 8U) {
+            *p++ = (char)('0' + f->dlc);
+        }
     } else {
         for (uint8_t k = 0U; k < f->dlc && k < 8U; ++k) {
             *p++ = HEX[f->data[k] >> 4];

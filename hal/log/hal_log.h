@@ -21,8 +21,8 @@
 extern "C" {
 #endif
 
-#define HAL_LOG_CHUNK    (1U << 20) ///< read size; also the longest line accepted
-#define HAL_LOG_ERR_MAX  320U
+#define HAL_LOG_CHUNK   (1U << 20) ///< read size; also the longest line accepted
+#define HAL_LOG_ERR_MAX 320U
 
 typedef enum {
     HAL_LOG_FRAME = 0, ///< *out holds the next frame
@@ -42,15 +42,15 @@ typedef struct {
 } hal_log_stats_t;
 
 typedef struct {
-    FILE           *f;
-    bool            own_f;       ///< close f in hal_log_close
-    char           *buf;         ///< HAL_LOG_CHUNK bytes
-    size_t          start, end;  ///< unread bytes are buf[start, end)
-    bool            eof;
-    uint64_t        line_no;     ///< 1-based number of the line last returned
+    FILE *f;
+    bool own_f;        ///< close f in hal_log_close
+    char *buf;         ///< HAL_LOG_CHUNK bytes
+    size_t start, end; ///< unread bytes are buf[start, end)
+    bool eof;
+    uint64_t line_no; ///< 1-based number of the line last returned
     hal_log_stats_t stats;
-    char            path[256];
-    char            err[HAL_LOG_ERR_MAX];
+    char path[256];
+    char err[HAL_LOG_ERR_MAX];
 } hal_log_t;
 
 /// Open `path` ("-" is stdin). Returns 0, or -1 with l->err set (cannot open, out of memory).

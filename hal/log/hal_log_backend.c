@@ -7,7 +7,7 @@ int hal_log_backend_open(hal_ctx_t *ctx, const char *path, FILE *tx, const char 
 {
     memset(ctx, 0, sizeof *ctx);
     ctx->tx = tx;
-    snprintf(ctx->tx_iface, sizeof ctx->tx_iface, "%s", tx_iface != NULL ? tx_iface : "can0");
+    (void)snprintf(ctx->tx_iface, sizeof ctx->tx_iface, "%s", tx_iface != NULL ? tx_iface : "can0");
     if (hal_log_open(&ctx->log, path) != 0) {
         return -1;
     }

@@ -15,13 +15,13 @@
 
 struct hal_ctx {
     hal_log_t log;
-    bool      ok;                            ///< false after EOF or an error (log.err)
-    bool      at_eof;
-    uint64_t  now_us;                        ///< timestamp of the frame last received
-    FILE     *tx;                            ///< where hal_can_send writes; NULL: sends refused
-    char      tx_iface[CANDUMP_IFACE_MAX + 1];
-    uint64_t  tx_frames;                     ///< frames written
-    uint64_t  tx_refused;                    ///< sends refused (no stream, write error)
+    bool ok; ///< false after EOF or an error (log.err)
+    bool at_eof;
+    uint64_t now_us; ///< timestamp of the frame last received
+    FILE *tx;        ///< where hal_can_send writes; NULL: sends refused
+    char tx_iface[CANDUMP_IFACE_MAX + 1];
+    uint64_t tx_frames;  ///< frames written
+    uint64_t tx_refused; ///< sends refused (no stream, write error)
 };
 
 /// Open the log at `path` and send to `tx` (may be NULL) as interface `tx_iface`. Returns 0, or -1

@@ -27,9 +27,8 @@ bool hal_sim_init(hal_ctx_t *ctx, uint8_t trucks, bool has_link, const hal_sim_c
         return false;
     }
     memset(ctx, 0, sizeof *ctx);
-    if (cfg == NULL || trucks < 1U || trucks > ODO_TRUCKS ||
-        cfg->rotary_bits < HAL_SIM_ROTARY_BITS_MIN || cfg->rotary_bits > HAL_SIM_ROTARY_BITS_MAX ||
-        cfg->linear_resolution_um < 1U) {
+    if (cfg == NULL || trucks < 1U || trucks > ODO_TRUCKS || cfg->rotary_bits < HAL_SIM_ROTARY_BITS_MIN ||
+        cfg->rotary_bits > HAL_SIM_ROTARY_BITS_MAX || cfg->linear_resolution_um < 1U) {
         return false;
     }
     const odosim_hctl_config_t d = decoder_config(cfg);
@@ -55,8 +54,7 @@ odosim_hctl_t *hal_sim_decoder(hal_ctx_t *ctx, uint8_t truck, uint8_t wheel)
     return &ctx->dec[truck][wheel];
 }
 
-bool hal_sim_set_wheel_phase(hal_ctx_t *ctx, uint8_t truck, uint8_t wheel, double t_s,
-                             double phase_counts)
+bool hal_sim_set_wheel_phase(hal_ctx_t *ctx, uint8_t truck, uint8_t wheel, double t_s, double phase_counts)
 {
     odosim_hctl_t *h = hal_sim_decoder(ctx, truck, wheel);
     if (h == NULL || !odosim_hctl_advance(h, t_s, phase_counts)) {
@@ -85,8 +83,7 @@ bool hal_sim_quantise_angle(double angle_rad, uint8_t bits, uint16_t *out_bam16)
     return true;
 }
 
-bool hal_sim_set_link(hal_ctx_t *ctx, double alpha_rad, double beta_rad, double length_mm,
-                      uint8_t valid)
+bool hal_sim_set_link(hal_ctx_t *ctx, double alpha_rad, double beta_rad, double length_mm, uint8_t valid)
 {
     if (!ctx->has_link) {
         return false;
@@ -175,8 +172,7 @@ bool hal_wheel_read(hal_ctx_t *ctx, uint8_t truck, odo_wheel_input_t *out)
     if (truck >= ctx->trucks) {
         return false;
     }
-    static const uint8_t SKIPPED[2] = {ODO_WHEEL_STATUS_LEFT_SKIPPED,
-                                       ODO_WHEEL_STATUS_RIGHT_SKIPPED};
+    static const uint8_t SKIPPED[2] = {ODO_WHEEL_STATUS_LEFT_SKIPPED, ODO_WHEEL_STATUS_RIGHT_SKIPPED};
     memset(out, 0, sizeof *out);
     out->present = true; /* a direct read is always a fresh sample */
     out->bits = ODOSIM_HCTL_POS_BITS;

@@ -26,11 +26,11 @@
 #define HAL_SIM_ROTARY_BITS_MAX 16U
 
 typedef struct {
-    uint32_t           f_clk_hz;             ///< decoder CLK, ODOSIM_HCTL_F_CLK_MIN_HZ..MAX_HZ
-    odosim_hctl_conv_t convention;           ///< counting convention of the decoders
-    bool               force_per_edge;       ///< decoders never take their fast path (tests)
-    uint8_t            rotary_bits;          ///< absolute rotary linkage encoders, 1..16 bits/turn
-    uint32_t           linear_resolution_um; ///< linear linkage encoder step, >= 1 um
+    uint32_t f_clk_hz;             ///< decoder CLK, ODOSIM_HCTL_F_CLK_MIN_HZ..MAX_HZ
+    odosim_hctl_conv_t convention; ///< counting convention of the decoders
+    bool force_per_edge;           ///< decoders never take their fast path (tests)
+    uint8_t rotary_bits;           ///< absolute rotary linkage encoders, 1..16 bits/turn
+    uint32_t linear_resolution_um; ///< linear linkage encoder step, >= 1 um
 } hal_sim_config_t;
 
 /// Faults of the simulator's own inputs; counters only increase (saturating).
@@ -43,21 +43,21 @@ typedef struct {
 } hal_sim_faults_t;
 
 struct hal_ctx {
-    hal_sim_config_t  cfg;
-    uint8_t           trucks;                        ///< trucks with counters (1 or 2)
-    bool              has_link;                      ///< the vehicle has linkage encoders
-    uint64_t          now_us;                        ///< what hal_time_us returns
-    odosim_hctl_t     dec[ODO_TRUCKS][2];            ///< [truck][ODO_LEFT/ODO_RIGHT]
-    uint8_t           wheel_seq[ODO_TRUCKS];         ///< seq of the next wheel sample
-    uint32_t          skipped_seen[ODO_TRUCKS][2];   ///< decoder skipped count at the last read
-    odo_link_input_t  link;                          ///< latest quantised linkage reading
-    odo_can_frame_t   tx[HAL_SIM_MAX_TX];            ///< capture ring
-    uint64_t          tx_t_us[HAL_SIM_MAX_TX];
-    uint32_t          tx_head, tx_count;
-    odo_can_frame_t   rx[HAL_SIM_MAX_RX];            ///< queue for hal_can_recv
-    uint64_t          rx_t_us[HAL_SIM_MAX_RX];
-    uint32_t          rx_head, rx_count;
-    hal_sim_faults_t  faults;
+    hal_sim_config_t cfg;
+    uint8_t trucks;                       ///< trucks with counters (1 or 2)
+    bool has_link;                        ///< the vehicle has linkage encoders
+    uint64_t now_us;                      ///< what hal_time_us returns
+    odosim_hctl_t dec[ODO_TRUCKS][2];     ///< [truck][ODO_LEFT/ODO_RIGHT]
+    uint8_t wheel_seq[ODO_TRUCKS];        ///< seq of the next wheel sample
+    uint32_t skipped_seen[ODO_TRUCKS][2]; ///< decoder skipped count at the last read
+    odo_link_input_t link;                ///< latest quantised linkage reading
+    odo_can_frame_t tx[HAL_SIM_MAX_TX];   ///< capture ring
+    uint64_t tx_t_us[HAL_SIM_MAX_TX];
+    uint32_t tx_head, tx_count;
+    odo_can_frame_t rx[HAL_SIM_MAX_RX]; ///< queue for hal_can_recv
+    uint64_t rx_t_us[HAL_SIM_MAX_RX];
+    uint32_t rx_head, rx_count;
+    hal_sim_faults_t faults;
 };
 
 /// Reset to a backend with `trucks` (1 or 2) counter pairs and optional linkage encoders; every
@@ -69,8 +69,7 @@ bool hal_sim_init(hal_ctx_t *ctx, uint8_t trucks, bool has_link, const hal_sim_c
 /// that counts up depends on cfg.convention) at time t_s, at constant velocity since the last call
 /// (odosim_hctl_advance). Returns false iff truck/wheel is invalid or the emulator rejects the
 /// input (time backwards, NaN); counted in faults.bad_wheel_inputs. O(1) on the fast path.
-bool hal_sim_set_wheel_phase(hal_ctx_t *ctx, uint8_t truck, uint8_t wheel, double t_s,
-                             double phase_counts);
+bool hal_sim_set_wheel_phase(hal_ctx_t *ctx, uint8_t truck, uint8_t wheel, double t_s, double phase_counts);
 
 /// Present a new linkage reading for the next hal_link_read. Angles in radians (any value; taken
 /// modulo one turn), quantised like an n-bit absolute encoder: code = floor(turns * 2^n), reported
@@ -78,8 +77,7 @@ bool hal_sim_set_wheel_phase(hal_ctx_t *ctx, uint8_t truck, uint8_t wheel, doubl
 /// in um. `valid` is a set of ODO_LINK_STATUS_* bits; a NaN/infinite angle or a length outside
 /// 0..UINT32_MAX um clears its bit and counts faults.bad_link_inputs. Sequence numbers advance by
 /// one per call (rotary and linear). Returns false iff the backend has no linkage encoders.
-bool hal_sim_set_link(hal_ctx_t *ctx, double alpha_rad, double beta_rad, double length_mm,
-                      uint8_t valid);
+bool hal_sim_set_link(hal_ctx_t *ctx, double alpha_rad, double beta_rad, double length_mm, uint8_t valid);
 
 /// Set the clock hal_time_us returns. Going backwards is ignored (faults.bad_times).
 void hal_sim_set_time_us(hal_ctx_t *ctx, uint64_t t_us);

@@ -1,5 +1,5 @@
-/// hal_socketcan: CAN_RAW frame I/O (see hal_socketcan.h).
-#define _DEFAULT_SOURCE 1
+/// hal_socketcan: CAN_RAW frame I/O (see hal_socketcan.h). _DEFAULT_SOURCE (struct ifreq, SIOCGIFINDEX)
+/// comes from CMakeLists.txt.
 #include "hal_socketcan.h"
 
 #include <errno.h>
@@ -33,7 +33,7 @@ static int if_flags(int fd, const char *name)
 {
     struct ifreq ifr;
     memset(&ifr, 0, sizeof ifr);
-    snprintf(ifr.ifr_name, sizeof ifr.ifr_name, "%s", name);
+    (void)snprintf(ifr.ifr_name, sizeof ifr.ifr_name, "%s", name);
     if (ioctl(fd, SIOCGIFFLAGS, &ifr) != 0) {
         return -1;
     }
@@ -45,17 +45,18 @@ static int open_socket(hal_socketcan_t *s)
     const int fd = socket(PF_CAN, SOCK_RAW, CAN_RAW);
     if (fd < 0) {
         if (errno == EAFNOSUPPORT) {
-            snprintf(s->err, sizeof s->err,
-                     "this kernel has no SocketCAN (socket(AF_CAN): %s); load the can and can_raw "
-                     "modules", strerror(errno));
+            (void)snprintf(s->err, sizeof s->err,
+                           "this kernel has no SocketCAN (socket(AF_CAN): %s); load the can and can_raw "
+                           "modules",
+                           strerror(errno));
         } else {
-            snprintf(s->err, sizeof s->err, "socket(AF_CAN): %s", strerror(errno));
+            (void)snprintf(s->err, sizeof s->err, "socket(AF_CAN): %s", strerror(errno));
         }
         return -1;
     }
     const unsigned idx = if_nametoindex(s->ifname);
     if (idx == 0U) {
-        snprintf(s->err, sizeof s->err, "no interface '%s' (%s)", s->ifname, strerror(errno));
+        (void)snprintf(s->err, sizeof s->err, "no interface '%s' (%s)", s->ifname, strerror(errno));
         close(fd);
         return -1;
     }
@@ -70,7 +71,7 @@ static int open_socket(hal_socketcan_t *s)
          setsockopt(fd, SOL_CAN_RAW, CAN_RAW_FILTER, flt, (socklen_t)(s->n_ids * sizeof flt[0])) != 0) ||
         setsockopt(fd, SOL_CAN_RAW, CAN_RAW_ERR_FILTER, &errmask, sizeof errmask) != 0 ||
         setsockopt(fd, SOL_SOCKET, SO_TIMESTAMP, &one, sizeof one) != 0) {
-        snprintf(s->err, sizeof s->err, "%s: setsockopt: %s", s->ifname, strerror(errno));
+        (void)snprintf(s->err, sizeof s->err, "%s: setsockopt: %s", s->ifname, strerror(errno));
         close(fd);
         return -1;
     }
@@ -80,13 +81,13 @@ static int open_socket(hal_socketcan_t *s)
     addr.can_family = AF_CAN;
     addr.can_ifindex = (int)idx;
     if (bind(fd, (struct sockaddr *)&addr, sizeof addr) != 0) {
-        snprintf(s->err, sizeof s->err, "%s: bind: %s (is it a CAN interface?)", s->ifname, strerror(errno));
+        (void)snprintf(s->err, sizeof s->err, "%s: bind: %s (is it a CAN interface?)", s->ifname, strerror(errno));
         close(fd);
         return -1;
     }
     const int fl = fcntl(fd, F_GETFL, 0);
     if (fl < 0 || fcntl(fd, F_SETFL, fl | O_NONBLOCK) != 0) {
-        snprintf(s->err, sizeof s->err, "%s: fcntl: %s", s->ifname, strerror(errno));
+        (void)snprintf(s->err, sizeof s->err, "%s: fcntl: %s", s->ifname, strerror(errno));
         close(fd);
         return -1;
     }
@@ -102,21 +103,21 @@ int hal_socketcan_open(hal_socketcan_t *s, const char *ifname, const uint32_t *i
     memset(s, 0, sizeof *s);
     s->fd = -1;
     if (strlen(ifname) == 0U || strlen(ifname) >= sizeof s->ifname) {
-        snprintf(s->err, sizeof s->err, "interface name must be 1 to 15 characters");
+        (void)snprintf(s->err, sizeof s->err, "interface name must be 1 to 15 characters");
         return -1;
     }
     if (n_ids > HAL_SC_MAX_FILTERS) {
-        snprintf(s->err, sizeof s->err, "at most %u filter identifiers", HAL_SC_MAX_FILTERS);
+        (void)snprintf(s->err, sizeof s->err, "at most %u filter identifiers", HAL_SC_MAX_FILTERS);
         return -1;
     }
-    snprintf(s->ifname, sizeof s->ifname, "%s", ifname);
+    (void)snprintf(s->ifname, sizeof s->ifname, "%s", ifname);
     memcpy(s->ids, ids, n_ids * sizeof ids[0]);
     s->n_ids = n_ids;
     if (open_socket(s) != 0) {
         return -1;
     }
     if (!s->up) {
-        snprintf(s->err, sizeof s->err, "interface '%s' is down (ip link set %s up)", ifname, ifname);
+        (void)snprintf(s->err, sizeof s->err, "interface '%s' is down (ip link set %s up)", ifname, ifname);
         hal_socketcan_close(s);
         return -1;
     }
@@ -145,7 +146,7 @@ int hal_socketcan_wait(hal_socketcan_t *s, int timeout_ms)
         if (errno == EINTR) {
             return 0;
         }
-        snprintf(s->err, sizeof s->err, "%s: poll: %s", s->ifname, strerror(errno));
+        (void)snprintf(s->err, sizeof s->err, "%s: poll: %s", s->ifname, strerror(errno));
         return -1;
     }
     return r > 0 ? 1 : 0;
@@ -175,7 +176,7 @@ hal_sc_status_t hal_socketcan_recv(hal_socketcan_t *s, odo_can_frame_t *frame, u
             s->stats.down_events++;
             return HAL_SC_DOWN;
         }
-        snprintf(s->err, sizeof s->err, "%s: recvmsg: %s", s->ifname, strerror(errno));
+        (void)snprintf(s->err, sizeof s->err, "%s: recvmsg: %s", s->ifname, strerror(errno));
         return HAL_SC_ERROR;
     }
     if ((size_t)n < sizeof cf) {

@@ -45,15 +45,15 @@ typedef struct {
 } hal_sc_stats_t;
 
 typedef struct {
-    int            fd;
-    int            ifindex;
-    bool           up;          ///< last known interface state
-    char           ifname[16];
-    uint32_t       ids[HAL_SC_MAX_FILTERS];
-    size_t         n_ids;
-    uint32_t       kernel_drops; ///< last SO_RXQ_OVFL value seen
+    int fd;
+    int ifindex;
+    bool up; ///< last known interface state
+    char ifname[16];
+    uint32_t ids[HAL_SC_MAX_FILTERS];
+    size_t n_ids;
+    uint32_t kernel_drops; ///< last SO_RXQ_OVFL value seen
     hal_sc_stats_t stats;
-    char           err[256];
+    char err[256];
 } hal_socketcan_t;
 
 typedef enum {

@@ -9,8 +9,7 @@ void hal_test_init(hal_ctx_t *ctx, uint8_t trucks, bool has_link)
     ctx->has_link = has_link;
 }
 
-void hal_test_set_wheel(hal_ctx_t *ctx, uint8_t truck, uint32_t left_raw, uint32_t right_raw,
-                        uint8_t bits, uint8_t seq)
+void hal_test_set_wheel(hal_ctx_t *ctx, uint8_t truck, uint32_t left_raw, uint32_t right_raw, uint8_t bits, uint8_t seq)
 {
     odo_wheel_input_t *w = &ctx->wheel[truck];
     w->present = true;

@@ -1,10 +1,10 @@
 /// odo-sim: run one of the papers' experiments in the simulator with the firmware in the loop.
 /// Writes, per run, the sensor frames exactly as the robot's controllers put them on the bus
 /// (candump -l, can/odometry.dbc) and a ground-truth CSV; and for the set, returns.csv
-/// (000 Eq. 3.1) and summary.json. Output goes to a temporary folder renamed into place at the end,
-/// so a failed run leaves nothing behind.
-#include <dirent.h>
+/// (000 Eq. 3.1) and summary.json. The output folder follows hostlib/odo_out.h: built in a temp
+/// folder beside DIR and put into place at the end, so a failed run leaves DIR as it was.
 #include <errno.h>
+#include <getopt.h>
 #include <inttypes.h>
 #include <limits.h>
 #include <math.h>
@@ -16,6 +16,8 @@
 
 #include "candump.h"
 #include "data_dir.h"
+#include "odo_cli.h"
+#include "odo_out.h"
 #include "params_json.h"
 #include "effects.h"
 #include "odo/odo_can.h"
@@ -27,32 +29,36 @@
 
 static void usage(FILE *f)
 {
-    fprintf(f,
-            "usage: odo-sim --experiment NAME --vehicle labmate|clapper|set --scenario S.json --out DIR\n"
-            "               [--robot R.json] [--runs N] [--bumps N] [--ipec on|off|paper|estimator] [--seed S] [--quiet]\n"
-            "               [--log-start now|SECONDS]\n"
-            "       odo-sim --list-effects [--json]\n"
-            "\n"
-            "Experiments (000, 004): umbmark, umbmark-ext, straight-36m, rect-7x4. Closed paths run N\n"
-            "times in each direction (cw, ccw; default N = 5); straight-36m runs N times.\n"
-            "--robot defaults to host_sim/robots/<vehicle>.json. --seed overrides the scenario's seed.\n"
-            "Writes DIR/run-<dir>-NN.log (sensor frames, candump -l), DIR/run-<dir>-NN.truth.csv,\n"
-            "DIR/returns.csv and DIR/summary.json. An existing DIR is replaced only if it holds a\n"
-            "previous odo-sim output.\n"
-            "--log-start: the logs' first timestamp, whole seconds since the epoch (default\n"
-            "$SOURCE_DATE_EPOCH if set, else now; 0 for reproducible logs). The truth CSVs' t_s is\n"
-            "on the same clock.\n"
-            "--params P.json|P.bin: run the firmware with this parameter block's calibration (Ed, Eb,\n"
-            "Es per truck, e.g. from odo-calib umbmark --out-params); the world keeps the robot's true\n"
-            "geometry, and the block's nominal geometry must match the robot description's.\n");
+    fprintf(f, "usage: odo-sim --experiment NAME --vehicle labmate|clapper|set --scenario S.json --out DIR\n"
+               "               [--robot R.json] [--params P.json|P.bin] [--runs N] [--bumps N]\n"
+               "               [--ipec off|on|paper|estimator] [--seed S] [--log-start now|SECONDS]\n"
+               "               [--force] [--quiet]\n"
+               "       odo-sim --list-effects [--json]\n"
+               "       odo-sim --help | --version\n"
+               "\n"
+               "Experiments (000, 004): umbmark, umbmark-ext, straight-36m, rect-7x4. Closed paths run N\n"
+               "times in each direction (cw, ccw; default N = 5); straight-36m runs N times.\n"
+               "--robot defaults to host_sim/robots/<vehicle>.json. --seed overrides the scenario's seed.\n"
+               "Writes DIR/run-<dir>-NN.log (sensor frames, candump -l), DIR/run-<dir>-NN.truth.csv,\n"
+               "DIR/returns.csv and DIR/summary.json; missing parent folders are created. DIR is built\n"
+               "beside itself and renamed into place; an existing DIR must be empty or hold a previous\n"
+               "odo-sim output (its .odo-manifest: only the files listed there are replaced or removed);\n"
+               "--force writes into any other folder, replacing same-named files and removing nothing.\n"
+               "--log-start: the logs' first timestamp, whole seconds since the epoch (default\n"
+               "$SOURCE_DATE_EPOCH if set, else now; 0 for reproducible logs). The truth CSVs' t_s is\n"
+               "on the same clock.\n"
+               "--params P.json|P.bin: run the firmware with this parameter block's calibration (Ed, Eb,\n"
+               "Es per truck, e.g. from odo-calib umbmark --out-params); the world keeps the robot's true\n"
+               "geometry, and the block's nominal geometry must match the robot description's.\n"
+               "Exit status: 0 ok, 1 rejected input or I/O error, 2 usage error.\n");
 }
 
 typedef struct {
-    FILE    *log;
-    FILE    *truth;
+    FILE *log;
+    FILE *truth;
     uint64_t start_us; /* --log-start: added to every frame's time */
     unsigned trucks;
-    int      io_error;
+    int io_error;
 } run_files_t;
 
 static void write_sensor_frames(run_files_t *rf, const sim_tick_t *tk)
@@ -88,10 +94,9 @@ static void on_tick(void *user, const sim_tick_t *tk)
     const double deg = 180.0 / M_PI;
     /* on the log's clock: a whole-second start (--log-start) plus the run's time */
     fprintf(rf->truth, "%.3f,%.4f,%.4f,%.6f,%.4f,%.4f,%.6f,%.6f,%.6f,%.4f,",
-            (double)(rf->start_us / 1000000U) + tk->t_s, tk->truth[0].x_mm,
-            tk->truth[0].y_mm, tk->truth[0].theta_rad * deg, tk->truth[1].x_mm, tk->truth[1].y_mm,
-            tk->truth[1].theta_rad * deg, tk->link.alpha_rad * deg, tk->link.beta_rad * deg,
-            tk->link.length_mm);
+            (double)(rf->start_us / 1000000U) + tk->t_s, tk->truth[0].x_mm, tk->truth[0].y_mm,
+            tk->truth[0].theta_rad * deg, tk->truth[1].x_mm, tk->truth[1].y_mm, tk->truth[1].theta_rad * deg,
+            tk->link.alpha_rad * deg, tk->link.beta_rad * deg, tk->link.length_mm);
     for (size_t i = 0; i < tk->n_events; ++i) {
         const sim_bump_event_t *e = &tk->events[i];
         fprintf(rf->truth, "%sbump:%c:%s:h%.3f:x%.3f:y%.3f", i ? "|" : "", e->truck ? 'B' : 'A',
@@ -100,100 +105,41 @@ static void on_tick(void *user, const sim_tick_t *tk)
     fputc('\n', rf->truth);
 }
 
-/// Remove a folder holding only files (our own outputs).
-static void remove_flat_dir(const char *dir)
+static int write_returns(odo_out_dir_t *dir, const sim_return_t *r, size_t n, int straight, char *err, size_t errlen)
 {
-    DIR *d = opendir(dir);
-    if (d != NULL) {
-        struct dirent *e;
-        char path[PATH_MAX];
-        while ((e = readdir(d)) != NULL) {
-            if (strcmp(e->d_name, ".") != 0 && strcmp(e->d_name, "..") != 0) {
-                snprintf(path, sizeof path, "%s/%s", dir, e->d_name);
-                remove(path);
-            }
-        }
-        closedir(d);
-    }
-    rmdir(dir);
-}
-
-static int finish(const char *tmp, const char *out)
-{
-    struct stat sb;
-    if (stat(out, &sb) == 0) {
-        char marker[PATH_MAX];
-        snprintf(marker, sizeof marker, "%s/summary.json", out);
-        DIR *d = opendir(out);
-        int entries = 0;
-        if (d != NULL) {
-            for (struct dirent *e; (e = readdir(d)) != NULL;) {
-                entries += strcmp(e->d_name, ".") != 0 && strcmp(e->d_name, "..") != 0;
-            }
-            closedir(d);
-        }
-        if (!S_ISDIR(sb.st_mode) || (entries > 0 && access(marker, F_OK) != 0)) {
-            fprintf(stderr, "odo-sim: %s exists and is not a previous odo-sim output; not replacing it\n", out);
-            return -1;
-        }
-        char old[PATH_MAX];
-        snprintf(old, sizeof old, "%s.old.%ld", out, (long)getpid());
-        if (rename(out, old) != 0) {
-            fprintf(stderr, "odo-sim: cannot replace %s: %s\n", out, strerror(errno));
-            return -1;
-        }
-        if (rename(tmp, out) != 0) {
-            fprintf(stderr, "odo-sim: cannot move results to %s: %s\n", out, strerror(errno));
-            rename(old, out);
-            return -1;
-        }
-        remove_flat_dir(old);
-        return 0;
-    }
-    if (rename(tmp, out) != 0) {
-        fprintf(stderr, "odo-sim: cannot move results to %s: %s\n", out, strerror(errno));
-        return -1;
-    }
-    return 0;
-}
-
-static int write_returns(const char *dir, const sim_return_t *r, size_t n, int straight)
-{
-    char path[PATH_MAX];
-    snprintf(path, sizeof path, "%s/returns.csv", dir);
-    FILE *f = fopen(path, "w");
+    FILE *f = odo_out_dir_fopen(dir, "returns.csv", err, errlen);
     if (f == NULL) {
         return -1;
     }
     fprintf(f, "run,direction,x_abs_mm,y_abs_mm,theta_abs_deg,x_calc_mm,y_calc_mm,theta_calc_deg\n");
     for (size_t i = 0; i < n; ++i) {
         fprintf(f, "%u,%s,%.3f,%.3f,%.4f,%.3f,%.3f,%.4f\n", r[i].run, straight ? "fwd" : (r[i].ccw ? "ccw" : "cw"),
-                r[i].x_abs_mm, r[i].y_abs_mm, r[i].theta_abs_deg, r[i].x_calc_mm, r[i].y_calc_mm,
-                r[i].theta_calc_deg);
+                r[i].x_abs_mm, r[i].y_abs_mm, r[i].theta_abs_deg, r[i].x_calc_mm, r[i].y_calc_mm, r[i].theta_calc_deg);
     }
     return fclose(f) == 0 ? 0 : -1;
 }
 
-static int write_summary(const char *dir, const char *experiment, const char *vehicle, unsigned runs,
-                         uint64_t seed, const sim_return_t *r, size_t n, int straight)
+static int write_summary(odo_out_dir_t *dir, const char *experiment, const char *vehicle, unsigned runs, uint64_t seed,
+                         const sim_return_t *r, size_t n, int straight, char *err, size_t errlen)
 {
     sim_summary_t s;
     sim_summarise(r, n, &s);
-    char path[PATH_MAX];
-    snprintf(path, sizeof path, "%s/summary.json", dir);
-    FILE *f = fopen(path, "w");
+    FILE *f = odo_out_dir_fopen(dir, "summary.json", err, errlen);
     if (f == NULL) {
         return -1;
     }
-    fprintf(f, "{\n  \"experiment\": \"%s\",\n  \"vehicle\": \"%s\",\n  \"runs_per_direction\": %u,\n"
-               "  \"seed\": %" PRIu64 ",\n",
+    fprintf(f,
+            "{\n  \"experiment\": \"%s\",\n  \"vehicle\": \"%s\",\n  \"runs_per_direction\": %u,\n"
+            "  \"seed\": %" PRIu64 ",\n",
             experiment, vehicle, runs, seed);
-    fprintf(f, "  \"emax_syst_mm\": %.3f,\n  \"cg_cw_mm\": [%.3f, %.3f],\n  \"cg_ccw_mm\": [%.3f, %.3f],\n"
-               "  \"sigma_mm\": %.3f,\n  \"sem_mm\": %.3f,\n  \"avg_abs_theta_err_deg\": %.4f,\n  \"runs\": [\n",
-            s.emax_syst_mm, s.cg_cw_mm[0], s.cg_cw_mm[1], s.cg_ccw_mm[0], s.cg_ccw_mm[1], s.sigma_mm,
-            s.sem_mm, s.avg_abs_theta_err_deg);
+    fprintf(f,
+            "  \"emax_syst_mm\": %.3f,\n  \"cg_cw_mm\": [%.3f, %.3f],\n  \"cg_ccw_mm\": [%.3f, %.3f],\n"
+            "  \"sigma_mm\": %.3f,\n  \"sem_mm\": %.3f,\n  \"avg_abs_theta_err_deg\": %.4f,\n  \"runs\": [\n",
+            s.emax_syst_mm, s.cg_cw_mm[0], s.cg_cw_mm[1], s.cg_ccw_mm[0], s.cg_ccw_mm[1], s.sigma_mm, s.sem_mm,
+            s.avg_abs_theta_err_deg);
     for (size_t i = 0; i < n; ++i) {
-        fprintf(f, "    {\"run\": %u, \"direction\": \"%s\", \"ex_mm\": %.3f, \"ey_mm\": %.3f, \"etheta_deg\": %.4f}%s\n",
+        fprintf(f,
+                "    {\"run\": %u, \"direction\": \"%s\", \"ex_mm\": %.3f, \"ey_mm\": %.3f, \"etheta_deg\": %.4f}%s\n",
                 r[i].run, straight ? "fwd" : (r[i].ccw ? "ccw" : "cw"), r[i].ex_mm, r[i].ey_mm, r[i].etheta_deg,
                 i + 1 < n ? "," : "");
     }
@@ -203,83 +149,109 @@ static int write_summary(const char *dir, const char *experiment, const char *ve
 
 int main(int argc, char **argv)
 {
-    const char *experiment = NULL, *vehicle_name = NULL, *scenario_path = NULL, *robot_path = NULL,
-               *out = NULL;
+    const char *experiment = NULL, *vehicle_name = NULL, *scenario_path = NULL, *robot_path = NULL, *out = NULL;
     long runs = 5, bumps = -1;
     int ipec = 0, quiet = 0, seed_given = 0, list_effects = 0, list_json = 0;
     uint64_t seed = 0;
     const char *params_path = NULL; /* --params: calibration for the firmware */
-    uint64_t log_start_us = 0U;     /* --log-start; else SOURCE_DATE_EPOCH, else the wall clock */
-    if (odo_log_start_default(&log_start_us) != 0) {
+    bool force = false;
+    uint64_t log_start_us = 0U; /* --log-start; else SOURCE_DATE_EPOCH, else the wall clock */
+    bool log_start_given = false;
+    enum {
+        O_EXPERIMENT = 256,
+        O_VEHICLE,
+        O_SCENARIO,
+        O_ROBOT,
+        O_PARAMS,
+        O_OUT,
+        O_RUNS,
+        O_BUMPS,
+        O_IPEC,
+        O_SEED,
+        O_FORCE,
+        O_QUIET,
+        O_JSON,
+        O_LIST,
+        O_VERSION,
+        O_LOG_START
+    };
+    static const struct option longopts[] = {{"experiment", required_argument, NULL, O_EXPERIMENT},
+                                             {"vehicle", required_argument, NULL, O_VEHICLE},
+                                             {"scenario", required_argument, NULL, O_SCENARIO},
+                                             {"robot", required_argument, NULL, O_ROBOT},
+                                             {"params", required_argument, NULL, O_PARAMS},
+                                             {"out", required_argument, NULL, O_OUT},
+                                             {"runs", required_argument, NULL, O_RUNS},
+                                             {"bumps", required_argument, NULL, O_BUMPS},
+                                             {"ipec", required_argument, NULL, O_IPEC},
+                                             {"seed", required_argument, NULL, O_SEED},
+                                             {"force", no_argument, NULL, O_FORCE},
+                                             {"quiet", no_argument, NULL, O_QUIET},
+                                             {"json", no_argument, NULL, O_JSON},
+                                             {"list-effects", no_argument, NULL, O_LIST},
+                                             {"version", no_argument, NULL, O_VERSION},
+                                             {"help", no_argument, NULL, 'h'},
+                                             {"log-start", required_argument, NULL, O_LOG_START},
+                                             {NULL, 0, NULL, 0}};
+    opterr = 1;
+    for (int c; (c = getopt_long(argc, argv, "h", longopts, NULL)) != -1;) {
+        switch (c) {
+        case 'h': usage(stdout); return 0;
+        case O_VERSION: odo_cli_print_version("odo-sim"); return 0;
+        case O_EXPERIMENT: experiment = optarg; break;
+        case O_VEHICLE: vehicle_name = optarg; break;
+        case O_SCENARIO: scenario_path = optarg; break;
+        case O_ROBOT: robot_path = optarg; break;
+        case O_PARAMS: params_path = optarg; break;
+        case O_OUT: out = optarg; break;
+        case O_RUNS:
+            if (!odo_cli_long("odo-sim", "--runs", optarg, 1, MAX_RUNS, &runs)) {
+                return 2;
+            }
+            break;
+        case O_BUMPS:
+            if (!odo_cli_long("odo-sim", "--bumps", optarg, 0, MAX_RUNS, &bumps)) {
+                return 2;
+            }
+            break;
+        case O_IPEC:
+            /* on = paper (002 Eqs. 9-16 per tick); estimator = the sub-resolution form. */
+            if ((ipec = odo_cli_ipec("odo-sim", optarg)) < 0) {
+                return 2;
+            }
+            break;
+        case O_SEED:
+            if (!odo_cli_seed("odo-sim", optarg, &seed)) {
+                return 2;
+            }
+            seed_given = 1;
+            break;
+        case O_LOG_START:
+            if (odo_log_start_parse(optarg, &log_start_us) != 0) {
+                fprintf(stderr, "odo-sim: --log-start must be now or whole seconds 0..%llu, not '%s'\n",
+                        (unsigned long long)ODO_LOG_START_MAX_S, optarg);
+                return 2;
+            }
+            log_start_given = true;
+            break;
+        case O_FORCE: force = true; break;
+        case O_QUIET: quiet = 1; break;
+        case O_JSON: list_json = 1; break;
+        case O_LIST: list_effects = 1; break;
+        default: odo_cli_usage_hint("odo-sim"); return 2;
+        }
+    }
+    /* the default is read only when it is needed, so --help and --log-start work whatever
+       SOURCE_DATE_EPOCH holds */
+    if (!log_start_given && odo_log_start_default(&log_start_us) != 0) {
         fprintf(stderr, "odo-sim: SOURCE_DATE_EPOCH must be whole seconds 0..%llu\n",
                 (unsigned long long)ODO_LOG_START_MAX_S);
         return 2;
     }
-    for (int i = 1; i < argc; ++i) {
-        const char *a = argv[i];
-        const char *v = i + 1 < argc ? argv[i + 1] : NULL;
-        char *end = NULL;
-        if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
-            usage(stdout);
-            return 0;
-        } else if (strcmp(a, "--list-effects") == 0) {
-            list_effects = 1;
-        } else if (strcmp(a, "--json") == 0) {
-            list_json = 1;
-        } else if (strcmp(a, "--quiet") == 0) {
-            quiet = 1;
-        } else if (v == NULL) {
-            fprintf(stderr, "odo-sim: %s needs a value (or is unknown)\n", a);
-            return 2;
-        } else if (strcmp(a, "--log-start") == 0) {
-            if (odo_log_start_parse(argv[++i], &log_start_us) != 0) {
-                fprintf(stderr, "odo-sim: --log-start must be now or whole seconds 0..%llu, not '%s'\n",
-                        (unsigned long long)ODO_LOG_START_MAX_S, argv[i]);
-                return 2;
-            }
-        } else if (strcmp(a, "--experiment") == 0) {
-            experiment = argv[++i];
-        } else if (strcmp(a, "--vehicle") == 0) {
-            vehicle_name = argv[++i];
-        } else if (strcmp(a, "--scenario") == 0) {
-            scenario_path = argv[++i];
-        } else if (strcmp(a, "--robot") == 0) {
-            robot_path = argv[++i];
-        } else if (strcmp(a, "--params") == 0) {
-            params_path = argv[++i];
-        } else if (strcmp(a, "--out") == 0) {
-            out = argv[++i];
-        } else if (strcmp(a, "--runs") == 0 || strcmp(a, "--bumps") == 0) {
-            errno = 0;
-            const long n = strtol(argv[++i], &end, 10);
-            if (errno != 0 || *end != '\0' || n < 0 || n > MAX_RUNS || (strcmp(a, "--runs") == 0 && n < 1)) {
-                fprintf(stderr, "odo-sim: %s must be an integer in [%d, %d], not '%s'\n", a,
-                        strcmp(a, "--runs") == 0 ? 1 : 0, MAX_RUNS, argv[i]);
-                return 2;
-            }
-            *(strcmp(a, "--runs") == 0 ? &runs : &bumps) = n;
-        } else if (strcmp(a, "--ipec") == 0) {
-            ++i;
-            /* on = paper (002 Eqs. 9-16 per tick); estimator = the sub-resolution form. */
-            if (strcmp(argv[i], "on") != 0 && strcmp(argv[i], "off") != 0 &&
-                strcmp(argv[i], "paper") != 0 && strcmp(argv[i], "estimator") != 0) {
-                fprintf(stderr, "odo-sim: --ipec must be on, off, paper or estimator, not '%s'\n", argv[i]);
-                return 2;
-            }
-            ipec = strcmp(argv[i], "off") == 0 ? 0 : strcmp(argv[i], "estimator") == 0 ? 2 : 1;
-        } else if (strcmp(a, "--seed") == 0) {
-            errno = 0;
-            seed = strtoull(argv[++i], &end, 10);
-            if (errno != 0 || *end != '\0' || argv[i][0] == '-') {
-                fprintf(stderr, "odo-sim: --seed must be a non-negative integer, not '%s'\n", argv[i]);
-                return 2;
-            }
-            seed_given = 1;
-        } else {
-            fprintf(stderr, "odo-sim: unknown argument '%s'\n", a);
-            usage(stderr);
-            return 2;
-        }
+    if (optind < argc) {
+        fprintf(stderr, "odo-sim: unexpected argument '%s'\n", argv[optind]);
+        odo_cli_usage_hint("odo-sim");
+        return 2;
     }
     if (list_effects) {
         return (list_json ? sim_effects_write_json(stdout) : sim_effects_write_markdown(stdout)) == 0 ? 0 : 1;
@@ -358,14 +330,15 @@ int main(int argc, char **argv)
         seed = scenario.seed;
     }
 
-    char tmp[PATH_MAX - 64];
-    if (strlen(out) + 32 >= sizeof tmp) {
-        fprintf(stderr, "odo-sim: output path too long\n");
-        return 2;
-    }
-    snprintf(tmp, sizeof tmp, "%s.tmp.%ld", out, (long)getpid());
-    if (mkdir(tmp, 0777) != 0) {
-        fprintf(stderr, "odo-sim: cannot create %s: %s\n", tmp, strerror(errno));
+    /* Inputs are never outputs: the robot, the scenario and the block must survive any --out. */
+    odo_out_inputs_t ins;
+    odo_out_inputs_init(&ins);
+    (void)odo_out_inputs_add(&ins, robot_path, err, sizeof err);
+    (void)odo_out_inputs_add(&ins, scenario_path, err, sizeof err);
+    (void)odo_out_inputs_add(&ins, params_path, err, sizeof err);
+    odo_out_dir_t *dir = odo_out_dir_begin(out, "odo-sim", force, &ins, err, sizeof err);
+    if (dir == NULL) {
+        fprintf(stderr, "odo-sim: %s\n", err);
         return 1;
     }
     const int straight = strcmp(experiment, "straight-36m") == 0;
@@ -376,22 +349,28 @@ int main(int argc, char **argv)
     for (int d = 0; d < dirs && rc == 0; ++d) {
         for (unsigned k = 0; k < (unsigned)runs && rc == 0; ++k) {
             const char *dname = straight ? "fwd" : (d ? "ccw" : "cw");
-            char path[PATH_MAX];
+            char name[64];
             run_files_t rf = {.trucks = robot.n_trucks, .start_us = log_start_us};
-            snprintf(path, sizeof path, "%s/run-%s-%02u.log", tmp, dname, k + 1);
-            rf.log = fopen(path, "w");
-            snprintf(path, sizeof path, "%s/run-%s-%02u.truth.csv", tmp, dname, k + 1);
-            rf.truth = fopen(path, "w");
+            snprintf(name, sizeof name, "run-%s-%02u.log", dname, k + 1);
+            rf.log = odo_out_dir_fopen(dir, name, err, sizeof err);
+            snprintf(name, sizeof name, "run-%s-%02u.truth.csv", dname, k + 1);
+            rf.truth = rf.log != NULL ? odo_out_dir_fopen(dir, name, err, sizeof err) : NULL;
             if (rf.log == NULL || rf.truth == NULL) {
-                fprintf(stderr, "odo-sim: cannot write in %s: %s\n", tmp, strerror(errno));
+                fprintf(stderr, "odo-sim: %s\n", err);
                 rc = -1;
             } else {
                 fprintf(rf.truth, "t_s,a_x_mm,a_y_mm,a_theta_deg,b_x_mm,b_y_mm,b_theta_deg,alpha_deg,"
                                   "beta_deg,l_mm,events\n");
                 const sim_run_config_t cfg = {
-                    .robot = &robot, .scenario = &scenario, .experiment = experiment, .ccw = d,
-                    .bumps = (int)bumps, .bump_height_mm = 10.0, .ipec = ipec,
-                    .seed = sim_run_seed(seed, d, k), .run_index = k,
+                    .robot = &robot,
+                    .scenario = &scenario,
+                    .experiment = experiment,
+                    .ccw = d,
+                    .bumps = (int)bumps,
+                    .bump_height_mm = 10.0,
+                    .ipec = ipec,
+                    .seed = sim_run_seed(seed, d, k),
+                    .run_index = k,
                 };
                 if (sim_run(&cfg, on_tick, &rf, &rets[n_ret], err, sizeof err) != 0) {
                     fprintf(stderr, "odo-sim: %s\n", err);
@@ -403,8 +382,7 @@ int main(int argc, char **argv)
                 }
                 n_ret++;
             }
-            if ((rf.log != NULL && fclose(rf.log) != 0) || (rf.truth != NULL && fclose(rf.truth) != 0) ||
-                rf.io_error) {
+            if ((rf.log != NULL && fclose(rf.log) != 0) || (rf.truth != NULL && fclose(rf.truth) != 0) || rf.io_error) {
                 if (rc == 0) {
                     fprintf(stderr, "odo-sim: writing run files failed\n");
                 }
@@ -412,20 +390,27 @@ int main(int argc, char **argv)
             }
         }
     }
-    if (rc == 0 && (write_returns(tmp, rets, n_ret, straight) != 0 ||
-                    write_summary(tmp, experiment, vehicle_name, (unsigned)runs, seed, rets, n_ret, straight) != 0)) {
-        fprintf(stderr, "odo-sim: writing the summary failed\n");
+    if (rc == 0 && (write_returns(dir, rets, n_ret, straight, err, sizeof err) != 0 ||
+                    write_summary(dir, experiment, vehicle_name, (unsigned)runs, seed, rets, n_ret, straight, err,
+                                  sizeof err) != 0)) {
+        fprintf(stderr, "odo-sim: writing the summary failed: %s\n", err);
         rc = -1;
     }
-    if (rc == 0 && finish(tmp, out) == 0) {
+    if (rc != 0) {
+        odo_out_dir_abort(dir);
+        return 1;
+    }
+    if (odo_out_dir_commit(dir, err, sizeof err) != 0) {
+        fprintf(stderr, "odo-sim: %s\n", err);
+        return 1;
+    }
+    {
         if (!quiet) {
             sim_summary_t s;
             sim_summarise(rets, n_ret, &s);
             fprintf(stderr, "odo-sim: Emax,syst %.1f mm (000 Eq. 3.4), SEM %.1f mm, avg |etheta| %.3f deg -> %s\n",
                     s.emax_syst_mm, s.sem_mm, s.avg_abs_theta_err_deg, out);
         }
-        return 0;
     }
-    remove_flat_dir(tmp);
-    return 1;
+    return 0;
 }

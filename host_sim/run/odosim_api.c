@@ -11,7 +11,7 @@
 #include "sil.h"
 
 struct odosim_setup {
-    sim_robot_t    robot;
+    sim_robot_t robot;
     sim_scenario_t scenario;
 };
 
@@ -47,8 +47,8 @@ odosim_setup_t *odosim_setup_parse(const char *robot_json, const char *scenario_
     return s;
 }
 
-int odosim_setup_set(odosim_setup_t *s, const char *effect, const char *param, unsigned truck_mask,
-                     double value, char *err, size_t errlen)
+int odosim_setup_set(odosim_setup_t *s, const char *effect, const char *param, unsigned truck_mask, double value,
+                     char *err, size_t errlen)
 {
     return sim_scenario_set(&s->scenario, effect, param, truck_mask, value, err, errlen);
 }
@@ -66,8 +66,8 @@ uint64_t odosim_run_seed(uint64_t base_seed, int ccw, unsigned run) { return sim
 
 typedef struct {
     odosim_tick_row_t *rows;
-    size_t             capacity;
-    size_t             n;
+    size_t capacity;
+    size_t n;
 } collect_t;
 
 static void collect(void *user, const sim_tick_t *tk)
@@ -125,8 +125,8 @@ static int check_ipec(int ipec, char *err, size_t errlen)
 }
 
 int odosim_run(const odosim_setup_t *s, const char *experiment, int ccw, int bumps, int ipec, uint64_t seed,
-               unsigned run_index, odosim_tick_row_t *rows, size_t capacity, odosim_result_t *result,
-               char *err, size_t errlen)
+               unsigned run_index, odosim_tick_row_t *rows, size_t capacity, odosim_result_t *result, char *err,
+               size_t errlen)
 {
     if (s == NULL || experiment == NULL || result == NULL) {
         snprintf(err, errlen, "NULL argument");
@@ -135,9 +135,15 @@ int odosim_run(const odosim_setup_t *s, const char *experiment, int ccw, int bum
     if (check_ipec(ipec, err, errlen) != 0) {
         return -1;
     }
-    const sim_run_config_t cfg = {.robot = &s->robot, .scenario = &s->scenario, .experiment = experiment,
-                                  .ccw = ccw ? 1 : 0, .bumps = bumps, .bump_height_mm = 10.0,
-                                  .ipec = ipec, .seed = seed, .run_index = run_index};
+    const sim_run_config_t cfg = {.robot = &s->robot,
+                                  .scenario = &s->scenario,
+                                  .experiment = experiment,
+                                  .ccw = ccw ? 1 : 0,
+                                  .bumps = bumps,
+                                  .bump_height_mm = 10.0,
+                                  .ipec = ipec,
+                                  .seed = seed,
+                                  .run_index = run_index};
     collect_t c = {rows, capacity, 0};
     sim_return_t ret;
     if (sim_run(&cfg, collect, &c, &ret, err, errlen) != 0) {
@@ -149,9 +155,9 @@ int odosim_run(const odosim_setup_t *s, const char *experiment, int ccw, int bum
 
 typedef struct {
     odosim_tick_row_ex_t *rows;
-    size_t                capacity, n;
-    odosim_event_t       *ev;
-    size_t                ev_capacity, n_ev;
+    size_t capacity, n;
+    odosim_event_t *ev;
+    size_t ev_capacity, n_ev;
 } collect_ex_t;
 
 static void collect_ex(void *user, const sim_tick_t *tk)
@@ -160,8 +166,8 @@ static void collect_ex(void *user, const sim_tick_t *tk)
     for (size_t i = 0; i < tk->n_events; ++i, c->n_ev++) {
         if (c->ev != NULL && c->n_ev < c->ev_capacity) {
             const sim_bump_event_t *e = &tk->events[i];
-            c->ev[c->n_ev] = (odosim_event_t){e->t_s, e->x_mm, e->y_mm, e->height_mm, e->at_distance_mm,
-                                              e->truck, e->wheel};
+            c->ev[c->n_ev] =
+                (odosim_event_t){e->t_s, e->x_mm, e->y_mm, e->height_mm, e->at_distance_mm, e->truck, e->wheel};
         }
     }
     if (c->rows != NULL && c->n < c->capacity) {
@@ -197,9 +203,9 @@ static void collect_ex(void *user, const sim_tick_t *tk)
     c->n++;
 }
 
-int odosim_run_ex(const odosim_setup_t *s, const odosim_run_opts_t *o, odosim_tick_row_ex_t *rows,
-                  size_t capacity, odosim_event_t *events, size_t ev_capacity, size_t *n_events,
-                  odosim_result_t *result, char *err, size_t errlen)
+int odosim_run_ex(const odosim_setup_t *s, const odosim_run_opts_t *o, odosim_tick_row_ex_t *rows, size_t capacity,
+                  odosim_event_t *events, size_t ev_capacity, size_t *n_events, odosim_result_t *result, char *err,
+                  size_t errlen)
 {
     if (s == NULL || o == NULL || o->experiment == NULL || result == NULL) {
         snprintf(err, errlen, "NULL argument");
@@ -210,11 +216,17 @@ int odosim_run_ex(const odosim_setup_t *s, const odosim_run_opts_t *o, odosim_ti
     }
     const sim_hidden_t hidden = {o->motor_tau_s, o->diam_var_amp, o->diam_var_period_s, o->diam_drift_per_s,
                                  o->backlash_rad};
-    const sim_run_config_t cfg = {.robot = &s->robot, .scenario = &s->scenario, .experiment = o->experiment,
-                                  .ccw = o->ccw ? 1 : 0, .bumps = o->bumps,
+    const sim_run_config_t cfg = {.robot = &s->robot,
+                                  .scenario = &s->scenario,
+                                  .experiment = o->experiment,
+                                  .ccw = o->ccw ? 1 : 0,
+                                  .bumps = o->bumps,
                                   .bump_height_mm = o->bump_height_mm > 0.0 ? o->bump_height_mm : 10.0,
-                                  .ipec = o->ipec, .seed = o->seed, .run_index = o->run_index,
-                                  .physics_dt_s = o->physics_dt_s, .hidden = &hidden};
+                                  .ipec = o->ipec,
+                                  .seed = o->seed,
+                                  .run_index = o->run_index,
+                                  .physics_dt_s = o->physics_dt_s,
+                                  .hidden = &hidden};
     collect_ex_t c = {rows, capacity, 0, events, ev_capacity, 0};
     sim_return_t ret;
     if (sim_run(&cfg, collect_ex, &c, &ret, err, errlen) != 0) {

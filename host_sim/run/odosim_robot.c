@@ -81,16 +81,15 @@ char *odosim_robot_limits_json(void)
     const sim_robot_limit_t *l = sim_robot_limits(&n);
     json_t *a = json_array();
     for (size_t i = 0; i < n; ++i) {
-        json_array_append_new(a, json_pack("{s:s, s:f, s:f, s:s}", "key", l[i].key, "lo", l[i].lo, "hi", l[i].hi,
-                                           "unit", l[i].unit));
+        json_array_append_new(
+            a, json_pack("{s:s, s:f, s:f, s:s}", "key", l[i].key, "lo", l[i].lo, "hi", l[i].hi, "unit", l[i].unit));
     }
     char *s = json_dumps(a, JSON_COMPACT);
     json_decref(a);
     return s;
 }
 
-int odosim_firmware_track(const char *robot_path, const uint32_t *raw, size_t n, double *pose, char *err,
-                          size_t errlen)
+int odosim_firmware_track(const char *robot_path, const uint32_t *raw, size_t n, double *pose, char *err, size_t errlen)
 {
     sim_robot_t *r = calloc(1, sizeof *r);
     odo_app_t *app = calloc(1, sizeof *app);

@@ -12,22 +12,26 @@
 #include "odo_loop.h"
 
 #define MAX_RUN_S 3600.0
-#define B_BUMP_MARGIN_MM 100.0 /* a bump this close to where B stops would be met while turning */ /* a run that has not finished after an hour is a bug, not a result */
+#define B_BUMP_MARGIN_MM \
+    100.0 /* a bump this close to where B stops would be met while turning */ /* a run that has not finished after an hour is a bug, not a result */
 
 /// Everything one run needs; large, so allocated once per run.
 typedef struct {
-    sim_world_t       world;
-    hal_ctx_t         hal;
-    odo_app_t         app;
-    odo_tick_input_t  in;
+    sim_world_t world;
+    hal_ctx_t hal;
+    odo_app_t app;
+    odo_tick_input_t in;
     odo_tick_output_t out;
-    sim_program_t     prog;
-    sim_follower_t    follow;
+    sim_program_t prog;
+    sim_follower_t follow;
     sim_clapper_follower_t follow2; ///< clapper: both trucks
 } sil_state_t;
 
 static double q32_mm(int64_t v) { return (double)v / 4294967296.0; }
-static double q64_rad(uint64_t h) { return (double)(int32_t)(uint32_t)((h + 0x80000000ULL) >> 32) * (M_PI / 2147483648.0); }
+static double q64_rad(uint64_t h)
+{
+    return (double)(int32_t)(uint32_t)((h + 0x80000000ULL) >> 32) * (M_PI / 2147483648.0);
+}
 
 /// Where truck B's wheel meets a floor bump placed at path distance p (*at, in B's wheel travel):
 /// B runs the same path l behind A, so forward legs reach it l later and backward legs (B leading)
@@ -51,8 +55,8 @@ static bool travel_of_b(const sim_program_t *prog, double p, double l, double *a
         }
         if (p < pos + len) {
             double leg_end = pos + len;
-            for (size_t j = i + 1; j < prog->n_seg && (prog->seg[j].kind == SIM_SEG_LINE ||
-                                                       prog->seg[j].kind == SIM_SEG_ARC); ++j) {
+            for (size_t j = i + 1;
+                 j < prog->n_seg && (prog->seg[j].kind == SIM_SEG_LINE || prog->seg[j].kind == SIM_SEG_ARC); ++j) {
                 const sim_segment_t *n = &prog->seg[j];
                 leg_end += n->kind == SIM_SEG_LINE ? hypot(n->x1_mm - n->x0_mm, n->y1_mm - n->y0_mm)
                                                    : fabs(n->sweep_rad) * n->radius_mm;
@@ -79,8 +83,8 @@ static int setup(sil_state_t *st, const sim_run_config_t *cfg, char *err, size_t
     if (cfg->hidden != NULL && sim_world_set_hidden(&st->world, cfg->hidden, err, errlen) != 0) {
         return -1;
     }
-    if (sim_program_build(cfg->experiment, cfg->ccw, cfg->bumps, cfg->bump_height_mm, cfg->run_index,
-                          &st->prog, err, errlen) != 0) {
+    if (sim_program_build(cfg->experiment, cfg->ccw, cfg->bumps, cfg->bump_height_mm, cfg->run_index, &st->prog, err,
+                          errlen) != 0) {
         return -1;
     }
     if (clapper && sim_program_for_clapper(&st->prog, r->link.length_mm) != 0) {
@@ -119,8 +123,7 @@ static int setup(sil_state_t *st, const sim_run_config_t *cfg, char *err, size_t
     const double f_clk = sim_world_count_loss_f_clk_hz(&st->world, ODO_TRUCK_A);
     hal_sim_config_t hc = {
         .f_clk_hz = f_clk > 0.0 ? (uint32_t)f_clk : ODOSIM_HCTL_F_CLK_MAX_HZ,
-        .convention = r->truck[0].decoder == SIM_DECODER_HCTL20XX ? ODOSIM_HCTL_CONV_20XX
-                                                                  : ODOSIM_HCTL_CONV_1100,
+        .convention = r->truck[0].decoder == SIM_DECODER_HCTL20XX ? ODOSIM_HCTL_CONV_20XX : ODOSIM_HCTL_CONV_1100,
         .force_per_edge = false,
         .rotary_bits = (uint8_t)(r->link.rotary_bits ? r->link.rotary_bits : 10U),
         .linear_resolution_um = (uint32_t)fmax(1.0, round(r->link.linear_resolution_mm * 1000.0)),
@@ -150,8 +153,7 @@ static void feed_encoders(sil_state_t *st, const sim_robot_t *r, double t_s)
     }
 }
 
-int sim_run(const sim_run_config_t *cfg, sim_tick_fn on_tick, void *user, sim_return_t *ret,
-            char *err, size_t errlen)
+int sim_run(const sim_run_config_t *cfg, sim_tick_fn on_tick, void *user, sim_return_t *ret, char *err, size_t errlen)
 {
     sil_state_t *st = calloc(1, sizeof *st);
     if (st == NULL) {
@@ -187,10 +189,14 @@ int sim_run(const sim_run_config_t *cfg, sim_tick_fn on_tick, void *user, sim_re
         const sim_bump_event_t *ev = sim_world_bump_events(&st->world, &n_ev);
         if (on_tick != NULL) {
             sim_tick_t tk = {
-                .t_s = sim_world_time_s(&st->world), .tick = tick,
+                .t_s = sim_world_time_s(&st->world),
+                .tick = tick,
                 .truth = {sim_world_pose(&st->world, 0), sim_world_pose(&st->world, 1)},
-                .link = sim_world_link_true(&st->world), .input = &st->in, .output = &st->out,
-                .events = ev + events_seen, .n_events = n_ev - events_seen,
+                .link = sim_world_link_true(&st->world),
+                .input = &st->in,
+                .output = &st->out,
+                .events = ev + events_seen,
+                .n_events = n_ev - events_seen,
             };
             on_tick(user, &tk);
         }
@@ -221,7 +227,8 @@ int sim_run(const sim_run_config_t *cfg, sim_tick_fn on_tick, void *user, sim_re
             const odo_pose_t *pa = &st->out.pose[ODO_TRUCK_A];
             double wheel[2];
             running = sim_follower_step(&st->follow, q32_mm(pa->x_mm_q32), q32_mm(pa->y_mm_q32),
-                                        q64_rad(pa->heading_q64), wheel) && running;
+                                        q64_rad(pa->heading_q64), wheel) &&
+                      running;
             cmd[0][0] = wheel[0];
             cmd[0][1] = wheel[1];
         }

@@ -11,8 +11,8 @@ bool sim_bump_geom(double radius_mm, double height_mm, sim_bump_model_t model, s
         return false;
     }
     memset(g, 0, sizeof *g);
-    if (!isfinite(radius_mm) || !isfinite(height_mm) || radius_mm <= 0.0 || height_mm < 0.0 ||
-        height_mm >= radius_mm || (model != SIM_BUMP_PAPER && model != SIM_BUMP_EXACT)) {
+    if (!isfinite(radius_mm) || !isfinite(height_mm) || radius_mm <= 0.0 || height_mm < 0.0 || height_mm >= radius_mm ||
+        (model != SIM_BUMP_PAPER && model != SIM_BUMP_EXACT)) {
         return false;
     }
     g->model = model;
@@ -22,12 +22,12 @@ bool sim_bump_geom(double radius_mm, double height_mm, sim_bump_model_t model, s
         return true;
     }
     const double r = radius_mm, h = height_mm;
-    g->d_hor_mm = sqrt(2.0 * r * h - h * h);       /* 004_997ef9ec5c850202.txt Eq. 2 */
-    g->psi0_rad = acos(1.0 - h / r);               /* contact angle: cos psi0 = (R - h) / R */
+    g->d_hor_mm = sqrt(2.0 * r * h - h * h); /* 004_997ef9ec5c850202.txt Eq. 2 */
+    g->psi0_rad = acos(1.0 - h / r);         /* contact angle: cos psi0 = (R - h) / R */
     if (model == SIM_BUMP_PAPER) {
         g->d_meas_mm = sqrt(g->d_hor_mm * g->d_hor_mm + h * h); /* 004 Eq. 3 (chord O-O') */
     } else {
-        g->d_meas_mm = r * g->psi0_rad;            /* arc swept about the edge: wheel rotation */
+        g->d_meas_mm = r * g->psi0_rad; /* arc swept about the edge: wheel rotation */
     }
     g->dd_mm = 2.0 * (g->d_meas_mm - g->d_hor_mm); /* 004 Eq. 1: up and down */
     return true;

@@ -38,12 +38,12 @@ typedef enum {
 /// Geometry of one bump under one wheel. All lengths in mm, per flank unless stated.
 typedef struct {
     sim_bump_model_t model;
-    double radius_mm;  ///< R, the wheel's true rolling radius
-    double height_mm;  ///< h
-    double d_hor_mm;   ///< centre's horizontal advance per flank, 004 Eq. 2 (both models)
-    double d_meas_mm;  ///< rotation (arc length) per flank: paper Eq. 3 chord, exact R * psi0
-    double dd_mm;      ///< linear error over the whole bump, 004 Eq. 1: 2 (D_meas - D_hor)
-    double psi0_rad;   ///< contact angle acos(1 - h/R) (exact model; also stored for paper)
+    double radius_mm; ///< R, the wheel's true rolling radius
+    double height_mm; ///< h
+    double d_hor_mm;  ///< centre's horizontal advance per flank, 004 Eq. 2 (both models)
+    double d_meas_mm; ///< rotation (arc length) per flank: paper Eq. 3 chord, exact R * psi0
+    double dd_mm;     ///< linear error over the whole bump, 004 Eq. 1: 2 (D_meas - D_hor)
+    double psi0_rad;  ///< contact angle acos(1 - h/R) (exact model; also stored for paper)
 } sim_bump_geom_t;
 
 /// Fill *g for a wheel of radius R over a bump of height h. h == 0 gives a null bump (all zero).

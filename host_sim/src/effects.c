@@ -12,73 +12,110 @@
 /* Sizes are typical of the papers; ranges are what the world can simulate sensibly (and, for the
  * calibration ratios, what the firmware's parameter block accepts: [0.8, 1.25], odo_params.h). */
 static const sim_effect_def_t catalog[SIM_EFFECT_COUNT] = {
-    [SIM_EFFECT_ED] = {SIM_EFFECT_ED, "ed", SIM_SCOPE_TRUCK, "000 Eqs. 2.7, 6.30-6.32",
-        "Unequal wheel diameters: Ed = DR/DL with the mean diameter kept (000 Eq. 6.30); a straight "
-        "command curves toward the smaller wheel",
-        1, {{"value", "1", SIM_PARAM_NUMBER, 1.0, 0.8, 1.25, NULL, "Ed = DR/DL (true diameters)"}}},
-    [SIM_EFFECT_EB] = {SIM_EFFECT_EB, "eb", SIM_SCOPE_TRUCK, "000 Eq. 2.8",
-        "Wheelbase error: true b = Eb * nominal b; on-the-spot turns come out 1/Eb of the commanded "
-        "angle",
-        1, {{"value", "1", SIM_PARAM_NUMBER, 1.0, 0.8, 1.25, NULL, "Eb = b_actual/b_nominal"}}},
-    [SIM_EFFECT_ES] = {SIM_EFFECT_ES, "es", SIM_SCOPE_TRUCK, "000 App. B, Eq. B.1",
-        "Scale error: Es = L_calc/L_actual, i.e. the true mean wheel diameter is Dn/Es",
-        1, {{"value", "1", SIM_PARAM_NUMBER, 1.0, 0.8, 1.25, NULL, "Es = L_calc/L_actual"}}},
-    [SIM_EFFECT_BUMPS] = {SIM_EFFECT_BUMPS, "bumps", SIM_SCOPE_TRUCK, "004 Eqs. 1-5, Table I",
-        "Discrete bumps: a rigid wheel over a thin step of height h turns more than it advances "
-        "(dD per bump); positions from the experiment or the scenario's \"at\" list",
-        2,
-        {{"height_mm", "mm", SIM_PARAM_NUMBER, 10.0, 0.0, 50.0, NULL, "step height h"},
-         {"model", "-", SIM_PARAM_ENUM, (double)SIM_BUMP_EXACT, 0.0, 1.0, ENUM_BUMP_MODEL,
-          "paper: 004 Eq. 3 chord (Table I); exact: pivot about the edge"}}},
-    [SIM_EFFECT_ROUGHNESS] = {SIM_EFFECT_ROUGHNESS, "roughness", SIM_SCOPE_TRUCK, "000 s. 4.6.2",
-        "Floor roughness: every ~spacing of its own travel each wheel meets a bump of random height "
-        "in [0, max] (independent per wheel, seeded)",
-        4,
-        {{"max_height_mm", "mm", SIM_PARAM_NUMBER, 1.0, 0.0, 10.0, NULL, "heights uniform in [0, max]"},
-         {"spacing_mm", "mm", SIM_PARAM_NUMBER, 20.0, 2.0, 1000.0, NULL, "mean distance between bumps"},
-         {"jitter", "1", SIM_PARAM_NUMBER, 0.5, 0.0, 0.95, NULL,
-          "gap = spacing * (1 + jitter * U(-1, 1))"},
-         {"model", "-", SIM_PARAM_ENUM, (double)SIM_BUMP_EXACT, 0.0, 1.0, ENUM_BUMP_MODEL,
-          "bump model of each grain"}}},
-    [SIM_EFFECT_SLIP] = {SIM_EFFECT_SLIP, "slip", SIM_SCOPE_TRUCK, "000 s. 2 (over-acceleration)",
-        "Longitudinal slip under acceleration: slip fraction = k * max(0, abs(a) - a0), capped; the "
-        "wheel spins (speeding up) or drags (slowing down) relative to the floor",
-        3,
-        {{"k_per_m_s2", "1/(m/s^2)", SIM_PARAM_NUMBER, 0.02, 0.0, 1.0, NULL, "slip fraction per m/s^2"},
-         {"a0_m_s2", "m/s^2", SIM_PARAM_NUMBER, 0.5, 0.0, 20.0, NULL, "acceleration without slip"},
-         {"max_fraction", "1", SIM_PARAM_NUMBER, 0.2, 0.0, 0.9, NULL, "cap on the slip fraction"}}},
-    [SIM_EFFECT_SKID] = {SIM_EFFECT_SKID, "skid", SIM_SCOPE_TRUCK, "000 s. 2 (fast turning)",
-        "Lateral skid in fast turns: outward sideways speed = k * max(0, abs(v * omega) - a0); the "
-        "encoders do not see it",
-        2,
-        {{"k_s", "s", SIM_PARAM_NUMBER, 0.02, 0.0, 1.0, NULL, "lateral speed per m/s^2 of excess"},
-         {"a0_m_s2", "m/s^2", SIM_PARAM_NUMBER, 0.3, 0.0, 20.0, NULL, "centripetal threshold"}}},
-    [SIM_EFFECT_COUNT_LOSS] = {SIM_EFFECT_COUNT_LOSS, "count_loss", SIM_SCOPE_TRUCK,
-        "HCTL-1100 data sheet (input filter)",
-        "Encoder count loss: the decoder's 3-clock input filter drops quadrature states faster "
-        "than about f_CLK/3 (applied by the HCTL emulator)",
-        1, {{"f_clk_hz", "Hz", SIM_PARAM_NUMBER, 1.0e6, 1.0e5, 2.0e6, NULL, "decoder clock"}}},
-    [SIM_EFFECT_ROTARY_BIAS] = {SIM_EFFECT_ROTARY_BIAS, "rotary_bias", SIM_SCOPE_VEHICLE,
-        "002 s. 5.2",
-        "Linkage rotary encoder zero offsets: measured alpha/beta = true + bias (clapper; set: "
-        "alpha is the joint encoder)",
-        2,
-        {{"alpha_deg", "deg", SIM_PARAM_NUMBER, 0.0, -10.0, 10.0, NULL, "truck A encoder bias"},
-         {"beta_deg", "deg", SIM_PARAM_NUMBER, 0.0, -10.0, 10.0, NULL, "truck B encoder bias"}}},
-    [SIM_EFFECT_LINK_BIAS] = {SIM_EFFECT_LINK_BIAS, "link_bias", SIM_SCOPE_VEHICLE, "002 s. 5.2",
-        "Link-length bias: measured l = true l + const + ecc * (1 - cos(alpha - beta)) (clapper)",
-        2,
-        {{"const_mm", "mm", SIM_PARAM_NUMBER, 0.0, -50.0, 50.0, NULL, "constant bias"},
-         {"ecc_mm", "mm", SIM_PARAM_NUMBER, 0.0, -50.0, 50.0, NULL, "eccentric bias amplitude"}}},
-    [SIM_EFFECT_TIRE_COMPRESSION] = {SIM_EFFECT_TIRE_COMPRESSION, "tire_compression",
-        SIM_SCOPE_TRUCK, "000 s. 2.2 a, 004 s. 3.2 a",
-        "Load-dependent tyre radius: each radius shrinks by k * its wheel load; an off-centre load "
-        "acts like an Ed, the mean like an Es",
-        3,
-        {{"k_mm_per_kg", "mm/kg", SIM_PARAM_NUMBER, 0.002, 0.0, 0.1, NULL, "radius loss per kg"},
-         {"load_kg", "kg", SIM_PARAM_NUMBER, 100.0, 0.0, 2000.0, NULL, "load carried by the truck"},
-         {"lateral_offset_mm", "mm", SIM_PARAM_NUMBER, 0.0, -500.0, 500.0, NULL,
-          "centre of mass left (+) of the centre; must stay within b/2"}}},
+    [SIM_EFFECT_ED] = {SIM_EFFECT_ED,
+                       "ed",
+                       SIM_SCOPE_TRUCK,
+                       "000 Eqs. 2.7, 6.30-6.32",
+                       "Unequal wheel diameters: Ed = DR/DL with the mean diameter kept (000 Eq. 6.30); a straight "
+                       "command curves toward the smaller wheel",
+                       1,
+                       {{"value", "1", SIM_PARAM_NUMBER, 1.0, 0.8, 1.25, NULL, "Ed = DR/DL (true diameters)"}}},
+    [SIM_EFFECT_EB] = {SIM_EFFECT_EB,
+                       "eb",
+                       SIM_SCOPE_TRUCK,
+                       "000 Eq. 2.8",
+                       "Wheelbase error: true b = Eb * nominal b; on-the-spot turns come out 1/Eb of the commanded "
+                       "angle",
+                       1,
+                       {{"value", "1", SIM_PARAM_NUMBER, 1.0, 0.8, 1.25, NULL, "Eb = b_actual/b_nominal"}}},
+    [SIM_EFFECT_ES] = {SIM_EFFECT_ES,
+                       "es",
+                       SIM_SCOPE_TRUCK,
+                       "000 App. B, Eq. B.1",
+                       "Scale error: Es = L_calc/L_actual, i.e. the true mean wheel diameter is Dn/Es",
+                       1,
+                       {{"value", "1", SIM_PARAM_NUMBER, 1.0, 0.8, 1.25, NULL, "Es = L_calc/L_actual"}}},
+    [SIM_EFFECT_BUMPS] = {SIM_EFFECT_BUMPS,
+                          "bumps",
+                          SIM_SCOPE_TRUCK,
+                          "004 Eqs. 1-5, Table I",
+                          "Discrete bumps: a rigid wheel over a thin step of height h turns more than it advances "
+                          "(dD per bump); positions from the experiment or the scenario's \"at\" list",
+                          2,
+                          {{"height_mm", "mm", SIM_PARAM_NUMBER, 10.0, 0.0, 50.0, NULL, "step height h"},
+                           {"model", "-", SIM_PARAM_ENUM, (double)SIM_BUMP_EXACT, 0.0, 1.0, ENUM_BUMP_MODEL,
+                            "paper: 004 Eq. 3 chord (Table I); exact: pivot about the edge"}}},
+    [SIM_EFFECT_ROUGHNESS] =
+        {SIM_EFFECT_ROUGHNESS,
+         "roughness",
+         SIM_SCOPE_TRUCK,
+         "000 s. 4.6.2",
+         "Floor roughness: every ~spacing of its own travel each wheel meets a bump of random height "
+         "in [0, max] (independent per wheel, seeded)",
+         4,
+         {{"max_height_mm", "mm", SIM_PARAM_NUMBER, 1.0, 0.0, 10.0, NULL, "heights uniform in [0, max]"},
+          {"spacing_mm", "mm", SIM_PARAM_NUMBER, 20.0, 2.0, 1000.0, NULL, "mean distance between bumps"},
+          {"jitter", "1", SIM_PARAM_NUMBER, 0.5, 0.0, 0.95, NULL, "gap = spacing * (1 + jitter * U(-1, 1))"},
+          {"model", "-", SIM_PARAM_ENUM, (double)SIM_BUMP_EXACT, 0.0, 1.0, ENUM_BUMP_MODEL,
+           "bump model of each grain"}}},
+    [SIM_EFFECT_SLIP] = {SIM_EFFECT_SLIP,
+                         "slip",
+                         SIM_SCOPE_TRUCK,
+                         "000 s. 2 (over-acceleration)",
+                         "Longitudinal slip under acceleration: slip fraction = k * max(0, abs(a) - a0), capped; the "
+                         "wheel spins (speeding up) or drags (slowing down) relative to the floor",
+                         3,
+                         {{"k_per_m_s2", "1/(m/s^2)", SIM_PARAM_NUMBER, 0.02, 0.0, 1.0, NULL,
+                           "slip fraction per m/s^2"},
+                          {"a0_m_s2", "m/s^2", SIM_PARAM_NUMBER, 0.5, 0.0, 20.0, NULL, "acceleration without slip"},
+                          {"max_fraction", "1", SIM_PARAM_NUMBER, 0.2, 0.0, 0.9, NULL, "cap on the slip fraction"}}},
+    [SIM_EFFECT_SKID] = {SIM_EFFECT_SKID,
+                         "skid",
+                         SIM_SCOPE_TRUCK,
+                         "000 s. 2 (fast turning)",
+                         "Lateral skid in fast turns: outward sideways speed = k * max(0, abs(v * omega) - a0); the "
+                         "encoders do not see it",
+                         2,
+                         {{"k_s", "s", SIM_PARAM_NUMBER, 0.02, 0.0, 1.0, NULL, "lateral speed per m/s^2 of excess"},
+                          {"a0_m_s2", "m/s^2", SIM_PARAM_NUMBER, 0.3, 0.0, 20.0, NULL, "centripetal threshold"}}},
+    [SIM_EFFECT_COUNT_LOSS] = {SIM_EFFECT_COUNT_LOSS,
+                               "count_loss",
+                               SIM_SCOPE_TRUCK,
+                               "HCTL-1100 data sheet (input filter)",
+                               "Encoder count loss: the decoder's 3-clock input filter drops quadrature states faster "
+                               "than about f_CLK/3 (applied by the HCTL emulator)",
+                               1,
+                               {{"f_clk_hz", "Hz", SIM_PARAM_NUMBER, 1.0e6, 1.0e5, 2.0e6, NULL, "decoder clock"}}},
+    [SIM_EFFECT_ROTARY_BIAS] = {SIM_EFFECT_ROTARY_BIAS,
+                                "rotary_bias",
+                                SIM_SCOPE_VEHICLE,
+                                "002 s. 5.2",
+                                "Linkage rotary encoder zero offsets: measured alpha/beta = true + bias (clapper; set: "
+                                "alpha is the joint encoder)",
+                                2,
+                                {{"alpha_deg", "deg", SIM_PARAM_NUMBER, 0.0, -10.0, 10.0, NULL, "truck A encoder bias"},
+                                 {"beta_deg", "deg", SIM_PARAM_NUMBER, 0.0, -10.0, 10.0, NULL,
+                                  "truck B encoder bias"}}},
+    [SIM_EFFECT_LINK_BIAS] = {SIM_EFFECT_LINK_BIAS,
+                              "link_bias",
+                              SIM_SCOPE_VEHICLE,
+                              "002 s. 5.2",
+                              "Link-length bias: measured l = true l + const + ecc * (1 - cos(alpha - beta)) (clapper)",
+                              2,
+                              {{"const_mm", "mm", SIM_PARAM_NUMBER, 0.0, -50.0, 50.0, NULL, "constant bias"},
+                               {"ecc_mm", "mm", SIM_PARAM_NUMBER, 0.0, -50.0, 50.0, NULL, "eccentric bias amplitude"}}},
+    [SIM_EFFECT_TIRE_COMPRESSION] =
+        {SIM_EFFECT_TIRE_COMPRESSION,
+         "tire_compression",
+         SIM_SCOPE_TRUCK,
+         "000 s. 2.2 a, 004 s. 3.2 a",
+         "Load-dependent tyre radius: each radius shrinks by k * its wheel load; an off-centre load "
+         "acts like an Ed, the mean like an Es",
+         3,
+         {{"k_mm_per_kg", "mm/kg", SIM_PARAM_NUMBER, 0.002, 0.0, 0.1, NULL, "radius loss per kg"},
+          {"load_kg", "kg", SIM_PARAM_NUMBER, 100.0, 0.0, 2000.0, NULL, "load carried by the truck"},
+          {"lateral_offset_mm", "mm", SIM_PARAM_NUMBER, 0.0, -500.0, 500.0, NULL,
+           "centre of mass left (+) of the centre; must stay within b/2"}}},
 };
 
 const sim_effect_def_t *sim_effects_catalog(size_t *n)
@@ -176,8 +213,7 @@ int sim_effects_write_json(FILE *out)
                 }
                 json_object_set_new(o, "type", json_string("enum"));
                 json_object_set_new(o, "choices", ch);
-                json_object_set_new(o, "default",
-                                    json_string(choice_name(p->choices, (int)p->def, buf, sizeof buf)));
+                json_object_set_new(o, "default", json_string(choice_name(p->choices, (int)p->def, buf, sizeof buf)));
             } else {
                 json_object_set_new(o, "type", json_string("number"));
                 json_object_set_new(o, "default", json_real(p->def));
@@ -231,8 +267,7 @@ int sim_effects_write_markdown(FILE *out)
                 snprintf(range, sizeof range, "[%g, %g]", p->min, p->max);
             }
             fprintf(out, "| %s | %s | `%s` | %s | %s | %s | ", k == 0 ? e->name : "",
-                    k == 0 ? (e->scope == SIM_SCOPE_TRUCK ? "truck" : "vehicle") : "", p->name, p->unit, def,
-                    range);
+                    k == 0 ? (e->scope == SIM_SCOPE_TRUCK ? "truck" : "vehicle") : "", p->name, p->unit, def, range);
             md_cell(out, k == 0 ? e->doc : p->doc);
             if (k == 0) {
                 fputs(" (", out);
@@ -264,11 +299,11 @@ void sim_scenario_none(sim_scenario_t *sc)
 #if defined(__GNUC__)
 __attribute__((format(printf, 5, 6)))
 #endif
-static int fail(char *err, size_t errlen, const char *origin, const char *where, const char *fmt, ...)
+static int
+fail(char *err, size_t errlen, const char *origin, const char *where, const char *fmt, ...)
 {
     if (err != NULL && errlen > 0) {
-        int n = snprintf(err, errlen, "%s: %s%s", origin, where != NULL ? where : "",
-                         where != NULL ? ": " : "");
+        int n = snprintf(err, errlen, "%s: %s%s", origin, where != NULL ? where : "", where != NULL ? ": " : "");
         if (n >= 0 && (size_t)n < errlen) {
             va_list ap;
             va_start(ap, fmt);
@@ -320,32 +355,28 @@ static int param_from_json(const sim_param_def_t *p, const json_t *v, double *ou
 {
     if (p->kind == SIM_PARAM_ENUM) {
         if (!json_is_string(v)) {
-            return fail(err, errlen, origin, where, "expected a string (%s), got %s", p->choices,
-                        json_type_name(v));
+            return fail(err, errlen, origin, where, "expected a string (%s), got %s", p->choices, json_type_name(v));
         }
         const int idx = choice_index(p->choices, json_string_value(v));
         if (idx < 0) {
-            return fail(err, errlen, origin, where, "\"%s\" is not one of %s", json_string_value(v),
-                        p->choices);
+            return fail(err, errlen, origin, where, "\"%s\" is not one of %s", json_string_value(v), p->choices);
         }
         *out = (double)idx;
         return 0;
     }
     if (!json_is_number(v)) {
-        return fail(err, errlen, origin, where, "expected a number (%s), got %s", p->unit,
-                    json_type_name(v));
+        return fail(err, errlen, origin, where, "expected a number (%s), got %s", p->unit, json_type_name(v));
     }
     const double x = json_number_value(v);
     if (!isfinite(x) || x < p->min || x > p->max) {
-        return fail(err, errlen, origin, where, "%g is out of range [%g, %g] %s", x, p->min, p->max,
-                    p->unit);
+        return fail(err, errlen, origin, where, "%g is out of range [%g, %g] %s", x, p->min, p->max, p->unit);
     }
     *out = x;
     return 0;
 }
 
-static int parse_truck(const json_t *v, bool allow_both, unsigned *mask, const char *origin,
-                       const char *where, char *err, size_t errlen)
+static int parse_truck(const json_t *v, bool allow_both, unsigned *mask, const char *origin, const char *where,
+                       char *err, size_t errlen)
 {
     const char *s = json_is_string(v) ? json_string_value(v) : NULL;
     if (s != NULL && strcmp(s, "A") == 0) {
@@ -355,15 +386,14 @@ static int parse_truck(const json_t *v, bool allow_both, unsigned *mask, const c
     } else if (allow_both && s != NULL && strcmp(s, "both") == 0) {
         *mask = 3U;
     } else {
-        return fail(err, errlen, origin, where, "expected \"A\", \"B\"%s, got %s%s%s",
-                    allow_both ? " or \"both\"" : "", s ? "\"" : json_type_name(v), s ? s : "",
-                    s ? "\"" : "");
+        return fail(err, errlen, origin, where, "expected \"A\", \"B\"%s, got %s%s%s", allow_both ? " or \"both\"" : "",
+                    s ? "\"" : json_type_name(v), s ? s : "", s ? "\"" : "");
     }
     return 0;
 }
 
-static int parse_bump_list(const json_t *at, const char *prefix, double default_height,
-                           sim_scenario_t *sc, const char *origin, char *err, size_t errlen)
+static int parse_bump_list(const json_t *at, const char *prefix, double default_height, sim_scenario_t *sc,
+                           const char *origin, char *err, size_t errlen)
 {
     char where[160];
     snprintf(where, sizeof where, "%.140s.at", prefix);
@@ -375,7 +405,8 @@ static int parse_bump_list(const json_t *at, const char *prefix, double default_
     static const sim_param_def_t height = {"height_mm", "mm", SIM_PARAM_NUMBER, 10.0, 0.0, 50.0, NULL, ""};
     size_t i;
     json_t *item;
-    json_array_foreach(at, i, item) {
+    json_array_foreach(at, i, item)
+    {
         snprintf(where, sizeof where, "%.130s.at[%zu]", prefix, i);
         if (!json_is_object(item)) {
             return fail(err, errlen, origin, where, "expected an object, got %s", json_type_name(item));
@@ -387,7 +418,8 @@ static int parse_bump_list(const json_t *at, const char *prefix, double default_
         bool have_truck = false, have_wheel = false;
         const char *key;
         json_t *v;
-        json_object_foreach(item, key, v) {
+        json_object_foreach(item, key, v)
+        {
             char w2[200];
             snprintf(w2, sizeof w2, "%.150s.%.40s", where, key);
             if (strcmp(key, "truck") == 0) {
@@ -428,13 +460,11 @@ static int parse_bump_list(const json_t *at, const char *prefix, double default_
 }
 
 /* One effect instance (an object in "effects"). *covered accumulates the trucks already set. */
-static int parse_instance(const sim_effect_def_t *e, const json_t *obj, const char *prefix,
-                          sim_scenario_t *sc, unsigned *covered, const char *origin, char *err,
-                          size_t errlen)
+static int parse_instance(const sim_effect_def_t *e, const json_t *obj, const char *prefix, sim_scenario_t *sc,
+                          unsigned *covered, const char *origin, char *err, size_t errlen)
 {
     if (!json_is_object(obj)) {
-        return fail(err, errlen, origin, prefix, "expected an object of parameters, got %s",
-                    json_type_name(obj));
+        return fail(err, errlen, origin, prefix, "expected an object of parameters, got %s", json_type_name(obj));
     }
     sim_effect_setting_t s = sc->eff[e->id][0];
     s.enabled = true;
@@ -442,7 +472,8 @@ static int parse_instance(const sim_effect_def_t *e, const json_t *obj, const ch
     const json_t *at = NULL;
     const char *key;
     json_t *v;
-    json_object_foreach((json_t *)obj, key, v) {
+    json_object_foreach((json_t *)obj, key, v)
+    {
         char where[200];
         snprintf(where, sizeof where, "%.140s.%.50s", prefix, key);
         if (strcmp(key, "enabled") == 0) {
@@ -452,8 +483,7 @@ static int parse_instance(const sim_effect_def_t *e, const json_t *obj, const ch
             s.enabled = json_is_true(v);
         } else if (strcmp(key, "truck") == 0) {
             if (e->scope != SIM_SCOPE_TRUCK) {
-                return fail(err, errlen, origin, where, "'%s' is a vehicle effect: no truck selection",
-                            e->name);
+                return fail(err, errlen, origin, where, "'%s' is a vehicle effect: no truck selection", e->name);
             }
             if (parse_truck(v, true, &mask, origin, where, err, errlen) != 0) {
                 return -1;
@@ -465,8 +495,8 @@ static int parse_instance(const sim_effect_def_t *e, const json_t *obj, const ch
             if (k < 0) {
                 char known[160];
                 known_params(e, known, sizeof known);
-                return fail(err, errlen, origin, where, "unknown parameter of '%s' (known: %s%s, enabled%s)",
-                            e->name, known, e->scope == SIM_SCOPE_TRUCK ? ", truck" : "",
+                return fail(err, errlen, origin, where, "unknown parameter of '%s' (known: %s%s, enabled%s)", e->name,
+                            known, e->scope == SIM_SCOPE_TRUCK ? ", truck" : "",
                             e->id == SIM_EFFECT_BUMPS ? ", at" : "");
             }
             if (param_from_json(&e->params[k], v, &s.p[k], origin, where, err, errlen) != 0) {
@@ -479,8 +509,7 @@ static int parse_instance(const sim_effect_def_t *e, const json_t *obj, const ch
             continue;
         }
         if ((*covered & (1U << t)) != 0U) {
-            return fail(err, errlen, origin, prefix, "truck %c is set twice for '%s'", (char)('A' + t),
-                        e->name);
+            return fail(err, errlen, origin, prefix, "truck %c is set twice for '%s'", (char)('A' + t), e->name);
         }
         *covered |= 1U << t;
         sc->eff[e->id][t] = s;
@@ -499,7 +528,8 @@ static int parse_root(const json_t *root, const char *origin, sim_scenario_t *sc
     }
     const char *key;
     json_t *v;
-    json_object_foreach((json_t *)root, key, v) {
+    json_object_foreach((json_t *)root, key, v)
+    {
         if (strcmp(key, "description") != 0 && strcmp(key, "seed") != 0 && strcmp(key, "bump_model") != 0 &&
             strcmp(key, "effects") != 0) {
             return fail(err, errlen, origin, key, "unknown key (known: description, seed, bump_model, effects)");
@@ -515,8 +545,7 @@ static int parse_root(const json_t *root, const char *origin, sim_scenario_t *sc
     const json_t *seed = json_object_get(root, "seed");
     if (seed != NULL) {
         if (!json_is_integer(seed) || json_integer_value(seed) < 0) {
-            return fail(err, errlen, origin, "seed", "expected a non-negative integer, got %s",
-                        json_type_name(seed));
+            return fail(err, errlen, origin, "seed", "expected a non-negative integer, got %s", json_type_name(seed));
         }
         sc->seed = (uint64_t)json_integer_value(seed);
         sc->has_seed = true;
@@ -539,7 +568,8 @@ static int parse_root(const json_t *root, const char *origin, sim_scenario_t *sc
     if (!json_is_object(effects)) {
         return fail(err, errlen, origin, "effects", "expected an object, got %s", json_type_name(effects));
     }
-    json_object_foreach((json_t *)effects, key, v) {
+    json_object_foreach((json_t *)effects, key, v)
+    {
         char prefix[160];
         snprintf(prefix, sizeof prefix, "effects.%.100s", key);
         const sim_effect_def_t *e = sim_effect_find(key);
@@ -555,7 +585,8 @@ static int parse_root(const json_t *root, const char *origin, sim_scenario_t *sc
             }
             size_t i;
             json_t *item;
-            json_array_foreach(v, i, item) {
+            json_array_foreach(v, i, item)
+            {
                 char p2[180];
                 snprintf(p2, sizeof p2, "%.120s[%zu]", prefix, i);
                 if (parse_instance(e, item, p2, sc, &covered, origin, err, errlen) != 0) {
@@ -569,20 +600,19 @@ static int parse_root(const json_t *root, const char *origin, sim_scenario_t *sc
     return 0;
 }
 
-static int parse_loaded(json_t *root, const json_error_t *jerr, const char *origin, sim_scenario_t *sc,
-                        char *err, size_t errlen)
+static int parse_loaded(json_t *root, const json_error_t *jerr, const char *origin, sim_scenario_t *sc, char *err,
+                        size_t errlen)
 {
     if (root == NULL) {
-        return fail(err, errlen, origin, NULL, "malformed JSON at line %d column %d: %s", jerr->line,
-                    jerr->column, jerr->text);
+        return fail(err, errlen, origin, NULL, "malformed JSON at line %d column %d: %s", jerr->line, jerr->column,
+                    jerr->text);
     }
     const int rc = parse_root(root, origin, sc, err, errlen);
     json_decref(root);
     return rc;
 }
 
-int sim_scenario_parse_string(const char *json, const char *origin, sim_scenario_t *sc, char *err,
-                              size_t errlen)
+int sim_scenario_parse_string(const char *json, const char *origin, sim_scenario_t *sc, char *err, size_t errlen)
 {
     json_error_t jerr;
     if (origin == NULL) {
@@ -609,8 +639,8 @@ int sim_scenario_parse_file(const char *path, sim_scenario_t *sc, char *err, siz
     return parse_loaded(root, &jerr, path, sc, err, errlen);
 }
 
-int sim_scenario_set(sim_scenario_t *sc, const char *effect, const char *param, unsigned truck_mask,
-                     double value, char *err, size_t errlen)
+int sim_scenario_set(sim_scenario_t *sc, const char *effect, const char *param, unsigned truck_mask, double value,
+                     char *err, size_t errlen)
 {
     const sim_effect_def_t *e = sim_effect_find(effect);
     if (e == NULL) {
@@ -629,8 +659,8 @@ int sim_scenario_set(sim_scenario_t *sc, const char *effect, const char *param, 
         const sim_param_def_t *p = &e->params[k];
         if (!isfinite(value) || value < p->min || value > p->max ||
             (p->kind == SIM_PARAM_ENUM && value != floor(value))) {
-            return fail(err, errlen, "scenario", effect, "%s = %g is out of range [%g, %g] %s", param, value,
-                        p->min, p->max, p->unit);
+            return fail(err, errlen, "scenario", effect, "%s = %g is out of range [%g, %g] %s", param, value, p->min,
+                        p->max, p->unit);
         }
     }
     if (e->scope == SIM_SCOPE_VEHICLE) {
@@ -672,8 +702,7 @@ double sim_scenario_param(const sim_scenario_t *sc, sim_effect_id_t id, unsigned
     return sc->eff[id][truck].p[param];
 }
 
-double sim_scenario_param_named(const sim_scenario_t *sc, const char *effect, const char *param,
-                                unsigned truck)
+double sim_scenario_param_named(const sim_scenario_t *sc, const char *effect, const char *param, unsigned truck)
 {
     const sim_effect_def_t *e = sim_effect_find(effect);
     const int k = sim_effect_param_index(e, param);

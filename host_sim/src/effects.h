@@ -57,33 +57,33 @@ typedef enum {
 
 typedef enum {
     SIM_PARAM_NUMBER = 0, ///< a JSON number within [min, max]
-    SIM_PARAM_ENUM   = 1  ///< a JSON string, one of `choices` ("a|b"); stored as its index
+    SIM_PARAM_ENUM = 1    ///< a JSON string, one of `choices` ("a|b"); stored as its index
 } sim_param_kind_t;
 
 typedef enum {
-    SIM_SCOPE_TRUCK   = 0, ///< set per truck ("truck": "A" | "B" | "both")
-    SIM_SCOPE_VEHICLE = 1  ///< one setting for the vehicle (linkage effects)
+    SIM_SCOPE_TRUCK = 0,  ///< set per truck ("truck": "A" | "B" | "both")
+    SIM_SCOPE_VEHICLE = 1 ///< one setting for the vehicle (linkage effects)
 } sim_effect_scope_t;
 
 typedef struct {
-    const char      *name;    ///< JSON key
-    const char      *unit;    ///< "1" for dimensionless ratios
+    const char *name; ///< JSON key
+    const char *unit; ///< "1" for dimensionless ratios
     sim_param_kind_t kind;
-    double           def;     ///< default (enum: index into choices)
-    double           min;     ///< inclusive range (enum: 0 .. n_choices - 1)
-    double           max;
-    const char      *choices; ///< enum only: "paper|exact"; NULL for numbers
-    const char      *doc;     ///< one line
+    double def; ///< default (enum: index into choices)
+    double min; ///< inclusive range (enum: 0 .. n_choices - 1)
+    double max;
+    const char *choices; ///< enum only: "paper|exact"; NULL for numbers
+    const char *doc;     ///< one line
 } sim_param_def_t;
 
 typedef struct {
-    sim_effect_id_t    id;
-    const char        *name;   ///< JSON key in "effects"
+    sim_effect_id_t id;
+    const char *name; ///< JSON key in "effects"
     sim_effect_scope_t scope;
-    const char        *ref;    ///< paper reference, e.g. "000 Eq. 2.7"
-    const char        *doc;    ///< one line
-    size_t             n_params;
-    sim_param_def_t    params[SIM_EFFECT_MAX_PARAMS];
+    const char *ref; ///< paper reference, e.g. "000 Eq. 2.7"
+    const char *doc; ///< one line
+    size_t n_params;
+    sim_param_def_t params[SIM_EFFECT_MAX_PARAMS];
 } sim_effect_def_t;
 
 /// The catalog, indexed by sim_effect_id_t; *n (if not NULL) receives SIM_EFFECT_COUNT.
@@ -109,25 +109,25 @@ int sim_effects_write_markdown(FILE *out);
 /// One effect's setting on one truck. Parameters always hold valid values (defaults when the file
 /// does not give them), so readers never need the catalog to interpret a disabled effect.
 typedef struct {
-    bool   enabled;
+    bool enabled;
     double p[SIM_EFFECT_MAX_PARAMS]; ///< in catalog order; enums as their index
 } sim_effect_setting_t;
 
 /// A discrete bump listed in the scenario ("bumps" -> "at").
 typedef struct {
-    uint8_t truck;       ///< ODO_TRUCK_A / ODO_TRUCK_B
-    uint8_t wheel;       ///< ODO_LEFT / ODO_RIGHT
-    double  distance_mm; ///< along that wheel's cumulative true travel
-    double  height_mm;   ///< from the entry, else the effect's height_mm
+    uint8_t truck;      ///< ODO_TRUCK_A / ODO_TRUCK_B
+    uint8_t wheel;      ///< ODO_LEFT / ODO_RIGHT
+    double distance_mm; ///< along that wheel's cumulative true travel
+    double height_mm;   ///< from the entry, else the effect's height_mm
 } sim_scenario_bump_t;
 
 typedef struct {
-    uint64_t             seed;     ///< "seed" (default 1); the CLI's --seed overrides it
-    bool                 has_seed; ///< the file gave a seed
+    uint64_t seed;                                          ///< "seed" (default 1); the CLI's --seed overrides it
+    bool has_seed;                                          ///< the file gave a seed
     sim_effect_setting_t eff[SIM_EFFECT_COUNT][ODO_TRUCKS]; ///< vehicle-scoped: both entries equal
-    size_t               n_bumps;
-    sim_scenario_bump_t  bump[SIM_SCENARIO_MAX_BUMPS];
-    char                 description[160];
+    size_t n_bumps;
+    sim_scenario_bump_t bump[SIM_SCENARIO_MAX_BUMPS];
+    char description[160];
 } sim_scenario_t;
 
 /// No effect enabled, every parameter at its default, seed 1. Never fails.
@@ -139,15 +139,14 @@ void sim_scenario_none(sim_scenario_t *sc);
 int sim_scenario_parse_file(const char *path, sim_scenario_t *sc, char *err, size_t errlen);
 
 /// The same from a NUL-terminated string; `origin` names it in messages (e.g. "<inline>").
-int sim_scenario_parse_string(const char *json, const char *origin, sim_scenario_t *sc, char *err,
-                              size_t errlen);
+int sim_scenario_parse_string(const char *json, const char *origin, sim_scenario_t *sc, char *err, size_t errlen);
 
 /// Switch an effect on for the trucks in `truck_mask` (bit 0 A, bit 1 B; vehicle-scoped effects
 /// ignore the mask) and set one parameter (NULL: just enable, keeping current values). For tools
 /// that sweep effect settings without files. Returns 0, or -1 with a message for an unknown effect
 /// or parameter or an out-of-range value.
-int sim_scenario_set(sim_scenario_t *sc, const char *effect, const char *param, unsigned truck_mask,
-                     double value, char *err, size_t errlen);
+int sim_scenario_set(sim_scenario_t *sc, const char *effect, const char *param, unsigned truck_mask, double value,
+                     char *err, size_t errlen);
 
 /// Whether an effect is enabled on any truck.
 bool sim_scenario_enabled(const sim_scenario_t *sc, sim_effect_id_t id);
@@ -162,8 +161,7 @@ void sim_scenario_enabled_list(const sim_scenario_t *sc, bool out[SIM_EFFECT_COU
 double sim_scenario_param(const sim_scenario_t *sc, sim_effect_id_t id, unsigned truck, size_t param);
 
 /// A parameter value by names; NaN iff the effect or parameter is unknown.
-double sim_scenario_param_named(const sim_scenario_t *sc, const char *effect, const char *param,
-                                unsigned truck);
+double sim_scenario_param_named(const sim_scenario_t *sc, const char *effect, const char *param, unsigned truck);
 
 /* Parameter indices, in catalog order, for the world's hot path. */
 enum { SIM_P_ED_VALUE = 0 };

@@ -4,10 +4,10 @@
 #include <string.h>
 
 /* Cross-track loop natural frequency (see steer()); critically damped. */
-#define WN_RAD_S 1.0
+#define WN_RAD_S             1.0
 #define MIN_STEER_SPEED_MM_S 50.0
-#define LINE_DONE_MM 0.5
-#define TURN_DONE_RAD (0.01 * M_PI / 180.0)
+#define LINE_DONE_MM         0.5
+#define TURN_DONE_RAD        (0.01 * M_PI / 180.0)
 
 static double wrap_pi(double a) { return remainder(a, 2.0 * M_PI); }
 
@@ -47,8 +47,7 @@ static double steer(double v, double cross_mm, double heading_err)
 }
 
 /// Returns true while the segment is still running.
-static bool step_line(sim_follower_t *f, const sim_segment_t *s, double x, double y, double th,
-                      double out[2])
+static bool step_line(sim_follower_t *f, const sim_segment_t *s, double x, double y, double th, double out[2])
 {
     const double dx = s->x1_mm - s->x0_mm, dy = s->y1_mm - s->y0_mm, len = hypot(dx, dy);
     const double ux = dx / len, uy = dy / len;
@@ -77,8 +76,7 @@ static bool step_turn(sim_follower_t *f, const sim_segment_t *s, double th, doub
         return false;
     }
     const double half_b = f->wheelbase_mm / 2.0;
-    const double wheel = ramp(fabs(f->w_rad_s) * half_b, s->speed_mm_s, s->accel_mm_s2,
-                              fabs(err) * half_b, f->dt_s);
+    const double wheel = ramp(fabs(f->w_rad_s) * half_b, s->speed_mm_s, s->accel_mm_s2, fabs(err) * half_b, f->dt_s);
     const double w = copysign(wheel / half_b, err);
     f->v_mm_s = 0.0;
     f->w_rad_s = w;
@@ -86,8 +84,7 @@ static bool step_turn(sim_follower_t *f, const sim_segment_t *s, double th, doub
     return true;
 }
 
-static bool step_arc(sim_follower_t *f, const sim_segment_t *s, double x, double y, double th,
-                     double out[2])
+static bool step_arc(sim_follower_t *f, const sim_segment_t *s, double x, double y, double th, double out[2])
 {
     const double dir = s->sweep_rad >= 0.0 ? 1.0 : -1.0;
     const double a0 = atan2(s->y0_mm - s->cy_mm, s->x0_mm - s->cx_mm);
@@ -113,8 +110,7 @@ static bool step_arc(sim_follower_t *f, const sim_segment_t *s, double x, double
 
 /// Step the program from the estimated pose. Returns 0 once finished, 1 while running, and, when
 /// `yield_turns`, 2 on reaching a TURN segment without stepping it (the clapper turns its own way).
-static int follow(sim_follower_t *f, double x_mm, double y_mm, double theta_rad, double wheel_mm_s[2],
-                  bool yield_turns)
+static int follow(sim_follower_t *f, double x_mm, double y_mm, double theta_rad, double wheel_mm_s[2], bool yield_turns)
 {
     wheel_mm_s[0] = wheel_mm_s[1] = 0.0;
     while (f->seg < f->prog->n_seg) {
@@ -139,8 +135,8 @@ static int follow(sim_follower_t *f, double x_mm, double y_mm, double theta_rad,
             return 1;
         }
         /* Flowing segments (arc <-> line) keep their speed; stops and turns restart from rest. */
-        const bool flowing = s->kind == SIM_SEG_ARC ||
-                             (f->seg + 1 < f->prog->n_seg && f->prog->seg[f->seg + 1].kind == SIM_SEG_ARC);
+        const bool flowing =
+            s->kind == SIM_SEG_ARC || (f->seg + 1 < f->prog->n_seg && f->prog->seg[f->seg + 1].kind == SIM_SEG_ARC);
         if (!flowing) {
             f->v_mm_s = f->w_rad_s = 0.0;
         }
@@ -158,13 +154,13 @@ bool sim_follower_step(sim_follower_t *f, double x_mm, double y_mm, double theta
 /* ---------------------------------------------------------------------------------------------
  * Clapper: truck B follows A's path l behind; rigid turns about the midpoint
  * ------------------------------------------------------------------------------------------- */
-#define LINK_K_PER_S 8.0          /* l loop: v_B = v_A + k (l_meas - l_nom) */
-#define LINK_MAX_CORR_MM_S 400.0  /* cap on that correction */
-#define SYNC_K_PER_S 2.0          /* rigid turn: keeps both trucks' progress equal */
-#define REL_K_PER_S 3.0           /* rigid turn: holds each truck perpendicular to the link */
-#define SPIN_SETTLE_RAD (0.8 * M_PI / 180.0) /* a spin within this of its target ... */
-#define SPIN_SETTLE_TICKS 25U                /* ... for this many ticks is done */
-#define TILT_MAX_RAD 0.35         /* rigid turn: B's largest tilt for the l loop */
+#define LINK_K_PER_S       8.0                  /* l loop: v_B = v_A + k (l_meas - l_nom) */
+#define LINK_MAX_CORR_MM_S 400.0                /* cap on that correction */
+#define SYNC_K_PER_S       2.0                  /* rigid turn: keeps both trucks' progress equal */
+#define REL_K_PER_S        3.0                  /* rigid turn: holds each truck perpendicular to the link */
+#define SPIN_SETTLE_RAD    (0.8 * M_PI / 180.0) /* a spin within this of its target ... */
+#define SPIN_SETTLE_TICKS  25U                  /* ... for this many ticks is done */
+#define TILT_MAX_RAD       0.35                 /* rigid turn: B's largest tilt for the l loop */
 
 /// Cross-track steering valid in both driving directions: for a truck moving at signed speed v
 /// with heading error eh (against its wanted heading) and cross-track error e (left of the path's
@@ -178,8 +174,7 @@ static void wheels_b(double wheelbase_mm, double v, double w, double out[2])
 
 /// Truck on a LINE/ARC segment at signed speed v: its turn rate (*w) and how much of the segment
 /// is left (*to_go, may be negative once past the end).
-static void track_segment(const sim_segment_t *s, double x, double y, double th, double v, double *w,
-                          double *to_go)
+static void track_segment(const sim_segment_t *s, double x, double y, double th, double v, double *w, double *to_go)
 {
     const bool backward = s->speed_mm_s < 0.0;
     if (s->kind == SIM_SEG_LINE) {
@@ -211,8 +206,7 @@ void sim_clapper_follower_init(sim_clapper_follower_t *f, const sim_program_t *p
 }
 
 /// On-the-spot turn of one truck to an absolute heading (as step_turn); false once there.
-static bool spin(sim_clapper_follower_t *f, unsigned t, const sim_segment_t *s, double target, double th,
-                 double out[2])
+static bool spin(sim_clapper_follower_t *f, unsigned t, const sim_segment_t *s, double target, double th, double out[2])
 {
     const double err = wrap_pi(target - th);
     out[0] = out[1] = 0.0;
@@ -225,8 +219,8 @@ static bool spin(sim_clapper_follower_t *f, unsigned t, const sim_segment_t *s, 
         return false;
     }
     const double b = t == 0U ? f->a.wheelbase_mm : f->wheelbase_b_mm, half_b = b / 2.0;
-    const double wheel = ramp(fabs(f->w_turn_rad_s[t]) * half_b, s->speed_mm_s, s->accel_mm_s2,
-                              fabs(err) * half_b, f->a.dt_s);
+    const double wheel =
+        ramp(fabs(f->w_turn_rad_s[t]) * half_b, s->speed_mm_s, s->accel_mm_s2, fabs(err) * half_b, f->a.dt_s);
     f->w_turn_rad_s[t] = copysign(wheel / half_b, err);
     wheels_b(b, 0.0, f->w_turn_rad_s[t], out);
     return true;
@@ -258,7 +252,7 @@ static bool arc_about_midpoint(sim_clapper_follower_t *f, const sim_segment_t *s
     const double r_true = link->length_mm > 0.0 ? link->length_mm / 2.0 : R;
     /* B tilts toward A (l long) or away (l short) by psi: radial speed v sin(psi). */
     const double psi = sg * fmax(-TILT_MAX_RAD, fmin(TILT_MAX_RAD, LINK_K_PER_S * (link->length_mm - f->l_nom_mm) /
-                                                                      fmax(v, MIN_STEER_SPEED_MM_S)));
+                                                                       fmax(v, MIN_STEER_SPEED_MM_S)));
     for (unsigned t = 0; t < 2U; ++t) {
         const double vt = fmax(0.0, v + SYNC_K_PER_S * (mean - done[t]) * R);
         const double vs = t == 0U ? vt : -vt; /* A drives forward along the circle, B backward */
@@ -283,8 +277,8 @@ static bool rigid_turn(sim_clapper_follower_t *f, const sim_segment_t *s, const 
                 const double rel = t == 0U ? link->alpha_rad : link->beta_rad;
                 /* Phase 0 aims each truck perpendicular to the link as measured (its centre does
                  * not move while it spins, so neither does the link); phase 2 at the new heading. */
-                f->spin_target_rad[t] = f->turn_phase == 0 ? pose[t][2] + wrap_pi(sg * M_PI / 2.0 - rel)
-                                                           : s->heading_rad;
+                f->spin_target_rad[t] =
+                    f->turn_phase == 0 ? pose[t][2] + wrap_pi(sg * M_PI / 2.0 - rel) : s->heading_rad;
                 f->arc_th0_rad[t] = pose[t][2];
             }
         }
@@ -338,7 +332,8 @@ bool sim_clapper_follower_step(sim_clapper_follower_t *f, const double pose[2][3
     }
     /* B's speed: A's, plus what brings the measured l back to nominal (the same sign serves both
      * directions: both trucks face the same way, so v_A - v_B is the rate at which l grows). */
-    const double corr = fmax(-LINK_MAX_CORR_MM_S, fmin(LINK_MAX_CORR_MM_S, LINK_K_PER_S * (link->length_mm - f->l_nom_mm)));
+    const double corr =
+        fmax(-LINK_MAX_CORR_MM_S, fmin(LINK_MAX_CORR_MM_S, LINK_K_PER_S * (link->length_mm - f->l_nom_mm)));
     const double v_b = f->a.v_mm_s + corr;
     double w_b = 0.0, to_go = 0.0;
     for (;;) {

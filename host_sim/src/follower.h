@@ -15,21 +15,20 @@
 
 typedef struct {
     const sim_program_t *prog;
-    double   wheelbase_mm;  ///< nominal (what the navigation computer believes)
-    double   dt_s;          ///< control period: the firmware tick
-    size_t   seg;           ///< current segment
-    double   seg_time_s;    ///< time spent in it
-    double   v_mm_s;        ///< last commanded centre speed
-    double   w_rad_s;       ///< last commanded turn rate
-    double   max_wheel_mm_s;
+    double wheelbase_mm; ///< nominal (what the navigation computer believes)
+    double dt_s;         ///< control period: the firmware tick
+    size_t seg;          ///< current segment
+    double seg_time_s;   ///< time spent in it
+    double v_mm_s;       ///< last commanded centre speed
+    double w_rad_s;      ///< last commanded turn rate
+    double max_wheel_mm_s;
 } sim_follower_t;
 
 void sim_follower_init(sim_follower_t *f, const sim_program_t *prog, double wheelbase_mm, double dt_s);
 
 /// One control step from the estimated pose; writes wheel surface speeds [left, right] in mm/s.
 /// Returns false once the program is finished (speeds are then zero).
-bool sim_follower_step(sim_follower_t *f, double x_mm, double y_mm, double theta_rad,
-                       double wheel_mm_s[2]);
+bool sim_follower_step(sim_follower_t *f, double x_mm, double y_mm, double theta_rad, double wheel_mm_s[2]);
 
 /// Clapper follower: the navigation computer driving both trucks of the clapper from the poses
 /// the firmware publishes for A and B and the linkage encoders' readings.
@@ -56,18 +55,18 @@ typedef struct {
 } sim_link_meas_t;
 
 typedef struct {
-    sim_follower_t a;          ///< truck A: the single-truck follower
-    double   wheelbase_b_mm;
-    double   l_nom_mm;
-    size_t   seg_b;            ///< truck B's own segment (LINE/ARC)
-    int      turn_phase;       ///< 0 spin to the circle, 1 arc about the midpoint, 2 spin to the new heading
-    bool     phase_started;
-    double   spin_target_rad[2];
-    double   arc_th0_rad[2];   ///< headings at the start of the phase
-    double   w_turn_rad_s[2];  ///< last on-the-spot rates (A, B), phases 0 and 2
-    double   w_arc_rad_s;      ///< last common angular speed about the midpoint, phase 1
-    double   v_b_mm_s;         ///< last commanded speed of B
-    unsigned spin_settled[2];  ///< ticks each truck's spin has been within SPIN_SETTLE_RAD
+    sim_follower_t a; ///< truck A: the single-truck follower
+    double wheelbase_b_mm;
+    double l_nom_mm;
+    size_t seg_b;   ///< truck B's own segment (LINE/ARC)
+    int turn_phase; ///< 0 spin to the circle, 1 arc about the midpoint, 2 spin to the new heading
+    bool phase_started;
+    double spin_target_rad[2];
+    double arc_th0_rad[2];    ///< headings at the start of the phase
+    double w_turn_rad_s[2];   ///< last on-the-spot rates (A, B), phases 0 and 2
+    double w_arc_rad_s;       ///< last common angular speed about the midpoint, phase 1
+    double v_b_mm_s;          ///< last commanded speed of B
+    unsigned spin_settled[2]; ///< ticks each truck's spin has been within SPIN_SETTLE_RAD
 } sim_clapper_follower_t;
 
 void sim_clapper_follower_init(sim_clapper_follower_t *f, const sim_program_t *prog, double wheelbase_a_mm,

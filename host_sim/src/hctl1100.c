@@ -25,10 +25,7 @@ static uint8_t state_ab(int64_t state)
 }
 
 /// +1 when the counter counts up for rising phase (HCTL-1100: B leads A), -1 for HCTL-20xx.
-static int64_t conv_sign(const odosim_hctl_t *h)
-{
-    return h->cfg.convention == ODOSIM_HCTL_CONV_20XX ? -1 : 1;
-}
+static int64_t conv_sign(const odosim_hctl_t *h) { return h->cfg.convention == ODOSIM_HCTL_CONV_20XX ? -1 : 1; }
 
 static void add_counts(odosim_hctl_t *h, int64_t delta)
 {
@@ -73,20 +70,14 @@ static void input_change(odosim_hctl_t *h, int64_t k0, int64_t state)
     h->diag.changes_per_edge++;
 }
 
-static bool finite_in(double x, double max)
-{
-    return isfinite(x) && fabs(x) <= max;
-}
+static bool finite_in(double x, double max) { return isfinite(x) && fabs(x) <= max; }
 
-bool odosim_hctl_init(odosim_hctl_t *h, const odosim_hctl_config_t *cfg, double t0_s,
-                      double phase0_counts)
+bool odosim_hctl_init(odosim_hctl_t *h, const odosim_hctl_config_t *cfg, double t0_s, double phase0_counts)
 {
     memset(h, 0, sizeof *h);
-    if (cfg == NULL || cfg->f_clk_hz < ODOSIM_HCTL_F_CLK_MIN_HZ ||
-        cfg->f_clk_hz > ODOSIM_HCTL_F_CLK_MAX_HZ ||
+    if (cfg == NULL || cfg->f_clk_hz < ODOSIM_HCTL_F_CLK_MIN_HZ || cfg->f_clk_hz > ODOSIM_HCTL_F_CLK_MAX_HZ ||
         (cfg->convention != ODOSIM_HCTL_CONV_1100 && cfg->convention != ODOSIM_HCTL_CONV_20XX) ||
-        !finite_in(t0_s, ODOSIM_HCTL_T_MAX_S) ||
-        !finite_in(phase0_counts, ODOSIM_HCTL_PHASE_MAX_COUNTS)) {
+        !finite_in(t0_s, ODOSIM_HCTL_T_MAX_S) || !finite_in(phase0_counts, ODOSIM_HCTL_PHASE_MAX_COUNTS)) {
         return false;
     }
     h->cfg = *cfg;
@@ -118,8 +109,7 @@ bool odosim_hctl_advance(odosim_hctl_t *h, double t_end_s, double phase_end_coun
         /* Seconds per state along this segment; 0 for a jump. Multiplying and adding a constant
          * is monotone in IEEE arithmetic, so the event times below never run backwards. */
         const double s_per_count = dt / dp;
-        const bool fast_ok = !h->cfg.force_per_edge && fabs(s_per_count) * h->f_clk >
-                                                           ODOSIM_HCTL_FAST_PERIODS;
+        const bool fast_ok = !h->cfg.force_per_edge && fabs(s_per_count) * h->f_clk > ODOSIM_HCTL_FAST_PERIODS;
         int64_t j = 1;
         while (j <= n) {
             /* Event j enters state s0 + dir*j: rising phase reaches the boundary s0 + j, falling
@@ -167,8 +157,7 @@ uint8_t odosim_hctl_read(odosim_hctl_t *h, uint8_t reg)
         h->latch_mid = live_mid;
         h->latched = true;
         return live_lsb;
-    case ODOSIM_HCTL_REG_ACT_POS_MID:
-        return h->latched ? h->latch_mid : live_mid;
+    case ODOSIM_HCTL_REG_ACT_POS_MID: return h->latched ? h->latch_mid : live_mid;
     case ODOSIM_HCTL_REG_ACT_POS_MSB:
         /* Model: the MSB read ends the sequence and releases the latch; without a pending latch
          * (R14H not read first) the upper bytes are live and may belong to another count. */
@@ -177,9 +166,7 @@ uint8_t odosim_hctl_read(odosim_hctl_t *h, uint8_t reg)
             return h->latch_msb;
         }
         return live_msb;
-    default:
-        inc32(&h->diag.bad_registers);
-        return 0U;
+    default: inc32(&h->diag.bad_registers); return 0U;
     }
 }
 
@@ -212,9 +199,7 @@ bool odosim_hctl_write(odosim_hctl_t *h, uint8_t reg, uint8_t value)
             h->latched = false;
         }
         return true;
-    default:
-        inc32(&h->diag.bad_registers);
-        return false;
+    default: inc32(&h->diag.bad_registers); return false;
     }
 }
 

@@ -76,8 +76,8 @@ extern "C" {
 #define ODOSIM_HCTL_FAST_PERIODS 4.0
 
 /// Input limits of odosim_hctl_advance (keep edge indices and floor(phase) exact in int64/double).
-#define ODOSIM_HCTL_T_MAX_S            1.0e9
-#define ODOSIM_HCTL_PHASE_MAX_COUNTS   4.0e15
+#define ODOSIM_HCTL_T_MAX_S          1.0e9
+#define ODOSIM_HCTL_PHASE_MAX_COUNTS 4.0e15
 
 /// Counting convention.
 typedef enum {
@@ -86,9 +86,9 @@ typedef enum {
 } odosim_hctl_conv_t;
 
 typedef struct {
-    uint32_t           f_clk_hz;       ///< ODOSIM_HCTL_F_CLK_MIN_HZ..ODOSIM_HCTL_F_CLK_MAX_HZ
+    uint32_t f_clk_hz; ///< ODOSIM_HCTL_F_CLK_MIN_HZ..ODOSIM_HCTL_F_CLK_MAX_HZ
     odosim_hctl_conv_t convention;
-    bool               force_per_edge; ///< never take the fast path (tests, diagnosis)
+    bool force_per_edge; ///< never take the fast path (tests, diagnosis)
 } odosim_hctl_config_t;
 
 /// Counters that only increase (they saturate at UINT32_MAX / UINT64_MAX).
@@ -106,29 +106,28 @@ typedef struct {
 /// private to hctl1100.c (read them through the functions below).
 typedef struct {
     odosim_hctl_config_t cfg;
-    double               f_clk;          ///< cfg.f_clk_hz as double
-    double               t_s;            ///< time of the last advance
-    double               phase_counts;   ///< phase at t_s
-    int64_t              raw_state;      ///< floor(phase): the unfiltered input state
-    uint8_t              filt_ab;        ///< filtered levels seen by the decoder: CHA << 1 | CHB
-    int64_t              pend_edge;      ///< CLK edge at which the raw state passes the filter,
-                                         ///< or INT64_MAX when it equals the filtered state
-    uint32_t             position;       ///< 24-bit actual position counter (upper byte zero)
-    bool                 latched;        ///< an R14H read latched R12H/R13H and R12H was not read yet
-    uint8_t              latch_msb;
-    uint8_t              latch_mid;
-    bool                 idle;           ///< idle mode: presets load
-    uint8_t              preset_msb;
-    uint8_t              preset_mid;
-    odosim_hctl_diag_t   diag;
+    double f_clk;        ///< cfg.f_clk_hz as double
+    double t_s;          ///< time of the last advance
+    double phase_counts; ///< phase at t_s
+    int64_t raw_state;   ///< floor(phase): the unfiltered input state
+    uint8_t filt_ab;     ///< filtered levels seen by the decoder: CHA << 1 | CHB
+    int64_t pend_edge;   ///< CLK edge at which the raw state passes the filter,
+                         ///< or INT64_MAX when it equals the filtered state
+    uint32_t position;   ///< 24-bit actual position counter (upper byte zero)
+    bool latched;        ///< an R14H read latched R12H/R13H and R12H was not read yet
+    uint8_t latch_msb;
+    uint8_t latch_mid;
+    bool idle; ///< idle mode: presets load
+    uint8_t preset_msb;
+    uint8_t preset_mid;
+    odosim_hctl_diag_t diag;
 } odosim_hctl_t;
 
 /// Power-on reset ("Operating Modes": Reset): position 0, no latch pending, not idle, filter settled on the input
 /// state of phase0_counts at time t0_s. Returns false iff cfg is NULL, f_clk_hz is out of range,
 /// the convention is unknown, or t0_s/phase0_counts are not finite; *h is then zeroed and every
 /// other call on it misbehaves harmlessly (returns zeros and counts bad inputs). O(1).
-bool odosim_hctl_init(odosim_hctl_t *h, const odosim_hctl_config_t *cfg, double t0_s,
-                      double phase0_counts);
+bool odosim_hctl_init(odosim_hctl_t *h, const odosim_hctl_config_t *cfg, double t0_s, double phase0_counts);
 
 /// Move the encoder from the last (t, phase) to (t_end_s, phase_end_counts) at constant velocity
 /// and clock every CLK edge strictly before t_end_s through the filter and the decoder (an edge at

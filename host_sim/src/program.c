@@ -36,13 +36,9 @@ static void turn(sim_program_t *p, double heading, double wheel_speed, double a)
     s->accel_mm_s2 = a;
 }
 
-static void pause_for(sim_program_t *p, double seconds)
-{
-    add(p, SIM_SEG_PAUSE)->pause_s = seconds;
-}
+static void pause_for(sim_program_t *p, double seconds) { add(p, SIM_SEG_PAUSE)->pause_s = seconds; }
 
-static void arc(sim_program_t *p, double cx, double cy, double r, double from_angle, double sweep,
-                double v, double a)
+static void arc(sim_program_t *p, double cx, double cy, double r, double from_angle, double sweep, double v, double a)
 {
     sim_segment_t *s = add(p, SIM_SEG_ARC);
     s->cx_mm = cx;
@@ -89,8 +85,8 @@ static int spread_bumps(sim_program_t *p, int n, double from, double length, uin
     return 0;
 }
 
-int sim_program_build(const char *experiment, int ccw, int bumps, double bump_height_mm,
-                      unsigned run_index, sim_program_t *out, char *err, size_t errlen)
+int sim_program_build(const char *experiment, int ccw, int bumps, double bump_height_mm, unsigned run_index,
+                      sim_program_t *out, char *err, size_t errlen)
 {
     memset(out, 0, sizeof *out);
     out->ccw = ccw ? 1 : 0;
@@ -98,12 +94,12 @@ int sim_program_build(const char *experiment, int ccw, int bumps, double bump_he
     int rc = 0;
     if (strcmp(experiment, "umbmark") == 0) {
         umbmark(out);
-        rc = spread_bumps(out, bumps < 0 ? 0 : bumps, 0.0, 4000.0, out->ccw ? ODO_LEFT : ODO_RIGHT,
+        rc = spread_bumps(out, bumps < 0 ? 0 : bumps, 0.0, 4000.0, (uint8_t)(out->ccw ? ODO_LEFT : ODO_RIGHT),
                           bump_height_mm);
     } else if (strcmp(experiment, "umbmark-ext") == 0) {
         /* 000 s. 3.4: the bumps go under the wheel facing the inside of the square, on leg 1. */
         umbmark(out);
-        rc = spread_bumps(out, bumps < 0 ? 10 : bumps, 0.0, 4000.0, out->ccw ? ODO_LEFT : ODO_RIGHT,
+        rc = spread_bumps(out, bumps < 0 ? 10 : bumps, 0.0, 4000.0, (uint8_t)(out->ccw ? ODO_LEFT : ODO_RIGHT),
                           bump_height_mm);
     } else if (strcmp(experiment, "straight-36m") == 0) {
         /* 004 s. 6.1: out 18 m, stop, back 18 m driving backward; bumps under the right wheels on
@@ -126,8 +122,8 @@ int sim_program_build(const char *experiment, int ccw, int bumps, double bump_he
         line(out, 0.0, s * (hgt - r), 0.0, s * r, v, a);
         arc(out, r, s * r, r, M_PI, s * M_PI / 2.0, v, a);
         line(out, r, 0.0, r + 1.0, 0.0, v, a); /* settle on the home heading */
-        rc = spread_bumps(out, bumps < 0 ? 10 : bumps, 0.0, out->path_mm,
-                          (run_index % 2U) == 0U ? ODO_RIGHT : ODO_LEFT, bump_height_mm);
+        rc = spread_bumps(out, bumps < 0 ? 10 : bumps, 0.0, out->path_mm, (run_index % 2U) == 0U ? ODO_RIGHT : ODO_LEFT,
+                          bump_height_mm);
     } else {
         snprintf(err, errlen, "unknown experiment '%s' (one of: umbmark, umbmark-ext, straight-36m, rect-7x4)",
                  experiment);

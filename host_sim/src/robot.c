@@ -152,18 +152,19 @@ static const sim_robot_limit_t *lim(const char *path, const char *key)
  * ------------------------------------------------------------------------------------------- */
 typedef struct {
     const char *origin;
-    char       *err;
-    size_t      errlen;
+    char *err;
+    size_t errlen;
 } ctx_t;
 
 #if defined(__GNUC__)
 __attribute__((format(printf, 3, 4)))
 #endif
-static int fail(const ctx_t *c, const char *field, const char *fmt, ...)
+static int
+fail(const ctx_t *c, const char *field, const char *fmt, ...)
 {
     if (c->err != NULL && c->errlen > 0) {
-        int n = snprintf(c->err, c->errlen, "%s: %s%s", c->origin, field != NULL ? field : "",
-                         field != NULL ? ": " : "");
+        int n =
+            snprintf(c->err, c->errlen, "%s: %s%s", c->origin, field != NULL ? field : "", field != NULL ? ": " : "");
         if (n >= 0 && (size_t)n < c->errlen) {
             va_list ap;
             va_start(ap, fmt);
@@ -176,11 +177,16 @@ static int fail(const ctx_t *c, const char *field, const char *fmt, ...)
 
 static const char *tname(const json_t *v)
 {
-    if (json_is_object(v)) return "an object";
-    if (json_is_array(v)) return "an array";
-    if (json_is_string(v)) return "a string";
-    if (json_is_number(v)) return "a number";
-    if (json_is_boolean(v)) return "a boolean";
+    if (json_is_object(v))
+        return "an object";
+    if (json_is_array(v))
+        return "an array";
+    if (json_is_string(v))
+        return "a string";
+    if (json_is_number(v))
+        return "a number";
+    if (json_is_boolean(v))
+        return "a boolean";
     return "null";
 }
 
@@ -189,7 +195,8 @@ static int only_keys(const ctx_t *c, const json_t *obj, const char *path, const 
 {
     const char *key;
     json_t *v;
-    json_object_foreach((json_t *)obj, key, v) {
+    json_object_foreach((json_t *)obj, key, v)
+    {
         bool ok = false;
         for (const char *const *k = keys; *k != NULL; ++k) {
             ok = ok || strcmp(*k, key) == 0;
@@ -215,8 +222,8 @@ static void field(char *buf, size_t cap, const char *path, const char *key)
 }
 
 /* Optional number in [lo, hi]; keeps *out if absent unless `required`. */
-static int get_num(const ctx_t *c, const json_t *obj, const char *path, const char *key, bool required,
-                   double lo, double hi, double *out)
+static int get_num(const ctx_t *c, const json_t *obj, const char *path, const char *key, bool required, double lo,
+                   double hi, double *out)
 {
     char f[160];
     field(f, sizeof f, path, key);
@@ -235,8 +242,8 @@ static int get_num(const ctx_t *c, const json_t *obj, const char *path, const ch
     return 0;
 }
 
-static int get_uint(const ctx_t *c, const json_t *obj, const char *path, const char *key, bool required,
-                    unsigned lo, unsigned hi, unsigned *out)
+static int get_uint(const ctx_t *c, const json_t *obj, const char *path, const char *key, bool required, unsigned lo,
+                    unsigned hi, unsigned *out)
 {
     char f[160];
     field(f, sizeof f, path, key);
@@ -315,18 +322,22 @@ static int get_obj(const ctx_t *c, const json_t *parent, const char *path, const
 
 static int parse_truck(const ctx_t *c, const json_t *o, const char *path, sim_truck_desc_t *t)
 {
-    static const char *const keys[] = {"wheel_diameter_mm", "wheelbase_mm", "encoder_lines", "gear_ratio",
-                                       "counter_bits", "decoder", "invert_left", "invert_right",
-                                       "calibration", NULL};
+    static const char *const keys[] = {
+        "wheel_diameter_mm", "wheelbase_mm", "encoder_lines", "gear_ratio",  "counter_bits",
+        "decoder",           "invert_left",  "invert_right",  "calibration", NULL};
     static const char *const decoders[] = {"hctl1100", "hctl20xx", NULL};
     static const char *const cal_keys[] = {"ed", "eb", "es", "scrub", NULL};
     unsigned dec = (unsigned)t->decoder;
     if (only_keys(c, o, path, keys) != 0 ||
-        get_num(c, o, path, "wheel_diameter_mm", true, LO(path, "wheel_diameter_mm"), HI(path, "wheel_diameter_mm"), &t->wheel_diameter_mm) != 0 ||
-        get_num(c, o, path, "wheelbase_mm", true, LO(path, "wheelbase_mm"), HI(path, "wheelbase_mm"), &t->wheelbase_mm) != 0 ||
-        get_uint(c, o, path, "encoder_lines", true, (unsigned)LO(path, "encoder_lines"), (unsigned)HI(path, "encoder_lines"), &t->encoder_lines) != 0 ||
+        get_num(c, o, path, "wheel_diameter_mm", true, LO(path, "wheel_diameter_mm"), HI(path, "wheel_diameter_mm"),
+                &t->wheel_diameter_mm) != 0 ||
+        get_num(c, o, path, "wheelbase_mm", true, LO(path, "wheelbase_mm"), HI(path, "wheelbase_mm"),
+                &t->wheelbase_mm) != 0 ||
+        get_uint(c, o, path, "encoder_lines", true, (unsigned)LO(path, "encoder_lines"),
+                 (unsigned)HI(path, "encoder_lines"), &t->encoder_lines) != 0 ||
         get_num(c, o, path, "gear_ratio", true, LO(path, "gear_ratio"), HI(path, "gear_ratio"), &t->gear_ratio) != 0 ||
-        get_uint(c, o, path, "counter_bits", false, (unsigned)LO(path, "counter_bits"), (unsigned)HI(path, "counter_bits"), &t->counter_bits) != 0 ||
+        get_uint(c, o, path, "counter_bits", false, (unsigned)LO(path, "counter_bits"),
+                 (unsigned)HI(path, "counter_bits"), &t->counter_bits) != 0 ||
         get_choice(c, o, path, "decoder", false, decoders, &dec) != 0 ||
         get_bool(c, o, path, "invert_left", &t->invert_left) != 0 ||
         get_bool(c, o, path, "invert_right", &t->invert_right) != 0) {
@@ -345,7 +356,8 @@ static int parse_truck(const ctx_t *c, const json_t *o, const char *path, sim_tr
     }
     if (cal != NULL) {
         field(f, sizeof f, path, "calibration");
-        if (only_keys(c, cal, f, cal_keys) != 0 || get_num(c, cal, f, "ed", false, LO(f, "ed"), HI(f, "ed"), &t->cal_ed) != 0 ||
+        if (only_keys(c, cal, f, cal_keys) != 0 ||
+            get_num(c, cal, f, "ed", false, LO(f, "ed"), HI(f, "ed"), &t->cal_ed) != 0 ||
             get_num(c, cal, f, "eb", false, LO(f, "eb"), HI(f, "eb"), &t->cal_eb) != 0 ||
             get_num(c, cal, f, "es", false, LO(f, "es"), HI(f, "es"), &t->cal_es) != 0 ||
             /* k of the firmware's tyre-scrub term (odo_odometry.h): |k| <= 0.25, as the block */
@@ -359,8 +371,9 @@ static int parse_truck(const ctx_t *c, const json_t *o, const char *path, sim_tr
 
 static int parse_root(const ctx_t *c, const json_t *root, sim_robot_t *r)
 {
-    static const char *const keys[] = {"vehicle", "description", "tick_ms", "heading_form", "ipec",
-                                       "max_wheel_speed_mm_s", "trucks", "linkage", "trailer", NULL};
+    static const char *const keys[] = {
+        "vehicle", "description", "tick_ms", "heading_form", "ipec", "max_wheel_speed_mm_s", "trucks",
+        "linkage", "trailer",     NULL};
     static const char *const vehicles[] = {"labmate", "clapper", "set", NULL};
     static const char *const forms[] = {"midpoint", "paper", NULL};
     static const char *const ipec[] = {"off", "paper", "estimator", NULL};
@@ -385,7 +398,8 @@ static int parse_root(const ctx_t *c, const json_t *root, sim_robot_t *r)
     if (get_num(c, root, "", "tick_ms", false, LO("", "tick_ms"), HI("", "tick_ms"), &r->tick_ms) != 0 ||
         get_choice(c, root, "", "heading_form", false, forms, &r->heading_form) != 0 ||
         get_choice(c, root, "", "ipec", false, ipec, &r->ipec_mode) != 0 ||
-        get_num(c, root, "", "max_wheel_speed_mm_s", false, LO("", "max_wheel_speed_mm_s"), HI("", "max_wheel_speed_mm_s"), &r->max_wheel_speed_mm_s) != 0) {
+        get_num(c, root, "", "max_wheel_speed_mm_s", false, LO("", "max_wheel_speed_mm_s"),
+                HI("", "max_wheel_speed_mm_s"), &r->max_wheel_speed_mm_s) != 0) {
         return -1;
     }
     if (fabs(r->tick_ms * 1000.0 - round(r->tick_ms * 1000.0)) > 1e-6) {
@@ -406,8 +420,10 @@ static int parse_root(const ctx_t *c, const json_t *root, sim_robot_t *r)
             return -1;
         }
         if (r->truck[1].counter_bits != r->truck[0].counter_bits) {
-            return fail(c, "trucks.B.counter_bits", "%u differs from trucks.A (%u): the firmware has one "
-                        "counter width", r->truck[1].counter_bits, r->truck[0].counter_bits);
+            return fail(c, "trucks.B.counter_bits",
+                        "%u differs from trucks.A (%u): the firmware has one "
+                        "counter width",
+                        r->truck[1].counter_bits, r->truck[0].counter_bits);
         }
     }
     const json_t *link = json_object_get(root, "linkage"), *trailer = json_object_get(root, "trailer");
@@ -418,16 +434,17 @@ static int parse_root(const ctx_t *c, const json_t *root, sim_robot_t *r)
         return fail(c, "trailer", "only a set has a trailer (vehicle is %s)", sim_vehicle_name(r->vehicle));
     }
     if (r->vehicle == SIM_VEHICLE_CLAPPER) {
-        static const char *const lk[] = {"length_mm", "range_mm", "rotary_bits", "linear_resolution_mm",
+        static const char *const lk[] = {"length_mm",   "range_mm", "rotary_bits", "linear_resolution_mm",
                                          "calibration", NULL};
-        static const char *const ck[] = {"length_bias_mm", "length_ecc_mm", "alpha_bias_deg",
-                                         "beta_bias_deg", NULL};
+        static const char *const ck[] = {"length_bias_mm", "length_ecc_mm", "alpha_bias_deg", "beta_bias_deg", NULL};
         const json_t *cal = NULL;
         if (get_obj(c, root, "", "linkage", true, &link) != 0 || only_keys(c, link, "linkage", lk) != 0 ||
-            get_num(c, link, "linkage", "length_mm", true, LO("linkage", "length_mm"), HI("linkage", "length_mm"), &r->link.length_mm) != 0 ||
-            get_uint(c, link, "linkage", "rotary_bits", false, (unsigned)LO("linkage", "rotary_bits"), (unsigned)HI("linkage", "rotary_bits"), &r->link.rotary_bits) != 0 ||
-            get_num(c, link, "linkage", "linear_resolution_mm", false, LO("linkage", "linear_resolution_mm"), HI("linkage", "linear_resolution_mm"),
-                    &r->link.linear_resolution_mm) != 0 ||
+            get_num(c, link, "linkage", "length_mm", true, LO("linkage", "length_mm"), HI("linkage", "length_mm"),
+                    &r->link.length_mm) != 0 ||
+            get_uint(c, link, "linkage", "rotary_bits", false, (unsigned)LO("linkage", "rotary_bits"),
+                     (unsigned)HI("linkage", "rotary_bits"), &r->link.rotary_bits) != 0 ||
+            get_num(c, link, "linkage", "linear_resolution_mm", false, LO("linkage", "linear_resolution_mm"),
+                    HI("linkage", "linear_resolution_mm"), &r->link.linear_resolution_mm) != 0 ||
             get_obj(c, link, "linkage", "calibration", false, &cal) != 0) {
             return -1;
         }
@@ -435,27 +452,30 @@ static int parse_root(const ctx_t *c, const json_t *root, sim_robot_t *r)
         r->link.max_mm = r->link.length_mm + 100.0;
         const json_t *range = json_object_get(link, "range_mm");
         if (range != NULL) {
-            if (!json_is_array(range) || json_array_size(range) != 2U ||
-                !json_is_number(json_array_get(range, 0)) || !json_is_number(json_array_get(range, 1))) {
+            if (!json_is_array(range) || json_array_size(range) != 2U || !json_is_number(json_array_get(range, 0)) ||
+                !json_is_number(json_array_get(range, 1))) {
                 return fail(c, "linkage.range_mm", "expected [min, max] in mm");
             }
             r->link.min_mm = json_number_value(json_array_get(range, 0));
             r->link.max_mm = json_number_value(json_array_get(range, 1));
-            if (!(r->link.min_mm >= 1.0 && r->link.min_mm < r->link.length_mm &&
-                  r->link.length_mm < r->link.max_mm && r->link.max_mm <= 20000.0)) {
+            if (!(r->link.min_mm >= 1.0 && r->link.min_mm < r->link.length_mm && r->link.length_mm < r->link.max_mm &&
+                  r->link.max_mm <= 20000.0)) {
                 return fail(c, "linkage.range_mm", "[%g, %g] must satisfy 1 <= min < length_mm (%g) < max <= 20000",
                             r->link.min_mm, r->link.max_mm, r->link.length_mm);
             }
         }
-        if (cal != NULL && (only_keys(c, cal, "linkage.calibration", ck) != 0 ||
-                            get_num(c, cal, "linkage.calibration", "length_bias_mm", false, LO("linkage.calibration", "length_bias_mm"), HI("linkage.calibration", "length_bias_mm"),
-                                    &r->link.cal_length_bias_mm) != 0 ||
-                            get_num(c, cal, "linkage.calibration", "length_ecc_mm", false, LO("linkage.calibration", "length_ecc_mm"), HI("linkage.calibration", "length_ecc_mm"),
-                                    &r->link.cal_length_ecc_mm) != 0 ||
-                            get_num(c, cal, "linkage.calibration", "alpha_bias_deg", false, LO("linkage.calibration", "alpha_bias_deg"), HI("linkage.calibration", "alpha_bias_deg"),
-                                    &r->link.cal_alpha_bias_deg) != 0 ||
-                            get_num(c, cal, "linkage.calibration", "beta_bias_deg", false, LO("linkage.calibration", "beta_bias_deg"), HI("linkage.calibration", "beta_bias_deg"),
-                                    &r->link.cal_beta_bias_deg) != 0)) {
+        if (cal != NULL &&
+            (only_keys(c, cal, "linkage.calibration", ck) != 0 ||
+             get_num(c, cal, "linkage.calibration", "length_bias_mm", false,
+                     LO("linkage.calibration", "length_bias_mm"), HI("linkage.calibration", "length_bias_mm"),
+                     &r->link.cal_length_bias_mm) != 0 ||
+             get_num(c, cal, "linkage.calibration", "length_ecc_mm", false, LO("linkage.calibration", "length_ecc_mm"),
+                     HI("linkage.calibration", "length_ecc_mm"), &r->link.cal_length_ecc_mm) != 0 ||
+             get_num(c, cal, "linkage.calibration", "alpha_bias_deg", false,
+                     LO("linkage.calibration", "alpha_bias_deg"), HI("linkage.calibration", "alpha_bias_deg"),
+                     &r->link.cal_alpha_bias_deg) != 0 ||
+             get_num(c, cal, "linkage.calibration", "beta_bias_deg", false, LO("linkage.calibration", "beta_bias_deg"),
+                     HI("linkage.calibration", "beta_bias_deg"), &r->link.cal_beta_bias_deg) != 0)) {
             return -1;
         }
     }
@@ -464,15 +484,19 @@ static int parse_root(const ctx_t *c, const json_t *root, sim_robot_t *r)
         static const char *const ck[] = {"alpha_bias_deg", NULL};
         const json_t *cal = NULL;
         if (get_obj(c, root, "", "trailer", true, &trailer) != 0 || only_keys(c, trailer, "trailer", tk) != 0 ||
-            get_num(c, trailer, "trailer", "hitch_offset_mm", true, LO("trailer", "hitch_offset_mm"), HI("trailer", "hitch_offset_mm"), &r->set.hitch_offset_mm) != 0 ||
-            get_num(c, trailer, "trailer", "trailer_length_mm", true, LO("trailer", "trailer_length_mm"), HI("trailer", "trailer_length_mm"), &r->set.trailer_length_mm) != 0 ||
-            get_uint(c, trailer, "trailer", "rotary_bits", false, (unsigned)LO("trailer", "rotary_bits"), (unsigned)HI("trailer", "rotary_bits"), &r->link.rotary_bits) != 0 ||
+            get_num(c, trailer, "trailer", "hitch_offset_mm", true, LO("trailer", "hitch_offset_mm"),
+                    HI("trailer", "hitch_offset_mm"), &r->set.hitch_offset_mm) != 0 ||
+            get_num(c, trailer, "trailer", "trailer_length_mm", true, LO("trailer", "trailer_length_mm"),
+                    HI("trailer", "trailer_length_mm"), &r->set.trailer_length_mm) != 0 ||
+            get_uint(c, trailer, "trailer", "rotary_bits", false, (unsigned)LO("trailer", "rotary_bits"),
+                     (unsigned)HI("trailer", "rotary_bits"), &r->link.rotary_bits) != 0 ||
             get_obj(c, trailer, "trailer", "calibration", false, &cal) != 0) {
             return -1;
         }
         if (cal != NULL && (only_keys(c, cal, "trailer.calibration", ck) != 0 ||
-                            get_num(c, cal, "trailer.calibration", "alpha_bias_deg", false, LO("trailer.calibration", "alpha_bias_deg"), HI("trailer.calibration", "alpha_bias_deg"),
-                                    &r->link.cal_alpha_bias_deg) != 0)) {
+                            get_num(c, cal, "trailer.calibration", "alpha_bias_deg", false,
+                                    LO("trailer.calibration", "alpha_bias_deg"),
+                                    HI("trailer.calibration", "alpha_bias_deg"), &r->link.cal_alpha_bias_deg) != 0)) {
             return -1;
         }
     }
@@ -605,8 +629,8 @@ int sim_robot_to_params(const sim_robot_t *r, odo_params_t *p, char *err, size_t
         tp->eb_q30 = sat_i32(d->cal_eb * TWO30);
         tp->es_q30 = sat_i32(d->cal_es * TWO30);
         tp->scrub_q30 = sat_i32(d->cal_scrub * TWO30);
-        tp->flags = (uint8_t)((d->invert_left ? ODO_TRUCK_INVERT_LEFT : 0U) |
-                              (d->invert_right ? ODO_TRUCK_INVERT_RIGHT : 0U));
+        tp->flags =
+            (uint8_t)((d->invert_left ? ODO_TRUCK_INVERT_LEFT : 0U) | (d->invert_right ? ODO_TRUCK_INVERT_RIGHT : 0U));
     }
     if (r->vehicle == SIM_VEHICLE_CLAPPER) {
         p->link.length_nm = sat_u32(r->link.length_mm * 1e6);
@@ -638,21 +662,24 @@ int sim_robot_to_params(const sim_robot_t *r, odo_params_t *p, char *err, size_t
      * counter must not wrap within one tick at the top wheel speed (odo_model_init). */
     for (unsigned t = 0; t < r->n_trucks && t < ODO_TRUCKS; ++t) {
         odo_model_t m;
-        if (odo_model_init(&m, &p->truck[t], p->counter_bits, p->heading_form, p->tick_us,
-                           p->max_wheel_speed_mm_s) != ODO_MODEL_OK) {
+        if (odo_model_init(&m, &p->truck[t], p->counter_bits, p->heading_form, p->tick_us, p->max_wheel_speed_mm_s) !=
+            ODO_MODEL_OK) {
             const sim_truck_desc_t *d = &r->truck[t];
             const double per_tick = r->max_wheel_speed_mm_s * r->tick_ms * 1e-3 /
                                     (M_PI * d->wheel_diameter_mm / sim_robot_counts_per_rev(d));
             char f[64];
             if (per_tick + 1.0 >= ldexp(1.0, (int)d->counter_bits - 1)) {
                 snprintf(f, sizeof f, "trucks.%c.counter_bits", t == 0U ? 'A' : 'B');
-                return fail(&c, f, "%u-bit counters wrap within one %g ms tick at max_wheel_speed_mm_s %g "
-                            "(%.0f counts per tick; the firmware needs fewer than %.0f)", d->counter_bits,
-                            r->tick_ms, r->max_wheel_speed_mm_s, per_tick, ldexp(1.0, (int)d->counter_bits - 1));
+                return fail(&c, f,
+                            "%u-bit counters wrap within one %g ms tick at max_wheel_speed_mm_s %g "
+                            "(%.0f counts per tick; the firmware needs fewer than %.0f)",
+                            d->counter_bits, r->tick_ms, r->max_wheel_speed_mm_s, per_tick,
+                            ldexp(1.0, (int)d->counter_bits - 1));
             }
             const double turns = 2.0 * r->max_wheel_speed_mm_s * r->tick_ms * 1e-3 / d->wheelbase_mm / (2.0 * M_PI);
             snprintf(f, sizeof f, "trucks.%c", t == 0U ? 'A' : 'B');
-            return fail(&c, f, "geometry beyond the firmware's fixed-point formats (odo_model_init): at "
+            return fail(&c, f,
+                        "geometry beyond the firmware's fixed-point formats (odo_model_init): at "
                         "max_wheel_speed_mm_s %g a %g ms tick may turn %.3g turns with wheelbase_mm %g",
                         r->max_wheel_speed_mm_s, r->tick_ms, turns, d->wheelbase_mm);
         }

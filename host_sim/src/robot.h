@@ -45,35 +45,35 @@ typedef enum { SIM_VEHICLE_LABMATE = 0, SIM_VEHICLE_CLAPPER = 1, SIM_VEHICLE_SET
 typedef enum { SIM_DECODER_HCTL1100 = 0, SIM_DECODER_HCTL20XX = 1 } sim_decoder_t;
 
 typedef struct {
-    double        wheel_diameter_mm; ///< nominal Dn
-    double        wheelbase_mm;      ///< nominal b
-    unsigned      encoder_lines;     ///< lines per motor (or wheel) revolution, Ce
-    double        gear_ratio;        ///< n, motor turns per wheel turn
-    unsigned      counter_bits;      ///< 8..32 (robot.c limits; the firmware decides what it runs)
+    double wheel_diameter_mm; ///< nominal Dn
+    double wheelbase_mm;      ///< nominal b
+    unsigned encoder_lines;   ///< lines per motor (or wheel) revolution, Ce
+    double gear_ratio;        ///< n, motor turns per wheel turn
+    unsigned counter_bits;    ///< 8..32 (robot.c limits; the firmware decides what it runs)
     sim_decoder_t decoder;
-    bool          invert_left;       ///< left counter counts down when the wheel rolls forward
-    bool          invert_right;
-    double        cal_ed, cal_eb, cal_es; ///< calibration block (1.0 when absent)
-    double        cal_scrub;         ///< k of the firmware's tyre-scrub term (0 when absent)
-    bool          has_calibration;
+    bool invert_left; ///< left counter counts down when the wheel rolls forward
+    bool invert_right;
+    double cal_ed, cal_eb, cal_es; ///< calibration block (1.0 when absent)
+    double cal_scrub;              ///< k of the firmware's tyre-scrub term (0 when absent)
+    bool has_calibration;
 } sim_truck_desc_t;
 
 typedef struct {
-    sim_vehicle_t    vehicle;
-    unsigned         n_trucks;       ///< 1 (labmate) or 2
-    char             description[160];
-    double           tick_ms;
-    unsigned         heading_form;   ///< odo_heading_form_t
-    unsigned         ipec_mode;      ///< odo_ipec_mode_t
-    double           max_wheel_speed_mm_s;
+    sim_vehicle_t vehicle;
+    unsigned n_trucks; ///< 1 (labmate) or 2
+    char description[160];
+    double tick_ms;
+    unsigned heading_form; ///< odo_heading_form_t
+    unsigned ipec_mode;    ///< odo_ipec_mode_t
+    double max_wheel_speed_mm_s;
     sim_truck_desc_t truck[ODO_TRUCKS]; ///< [1] valid iff n_trucks == 2 (B: rear truck / trailer)
     /// Clapper linkage (length, range, encoders) or the set's trailer joint (rotary_bits only).
     struct {
-        double   length_mm;              ///< clapper nominal l (004 s. 2: 1 m)
-        double   min_mm, max_mm;         ///< physical range of l (mechanical stops)
-        unsigned rotary_bits;            ///< absolute rotary encoders (004: 10 bit)
-        double   linear_resolution_mm;   ///< linear encoder (004: 0.1 mm)
-        double   cal_length_bias_mm, cal_length_ecc_mm, cal_alpha_bias_deg, cal_beta_bias_deg;
+        double length_mm;            ///< clapper nominal l (004 s. 2: 1 m)
+        double min_mm, max_mm;       ///< physical range of l (mechanical stops)
+        unsigned rotary_bits;        ///< absolute rotary encoders (004: 10 bit)
+        double linear_resolution_mm; ///< linear encoder (004: 0.1 mm)
+        double cal_length_bias_mm, cal_length_ecc_mm, cal_alpha_bias_deg, cal_beta_bias_deg;
     } link;
     struct {
         double hitch_offset_mm;   ///< robot centre to the joint, behind the robot
@@ -86,7 +86,7 @@ typedef struct {
 /// for either truck.
 typedef struct {
     const char *key;
-    double      lo, hi;
+    double lo, hi;
     const char *unit;
 } sim_robot_limit_t;
 

@@ -43,7 +43,7 @@ void sim_summarise(const sim_return_t *runs, size_t n, sim_summary_t *out)
         const int d = runs[i].ccw ? 1 : 0;
         ss += pow(runs[i].ex_mm - cg[d][0], 2) + pow(runs[i].ey_mm - cg[d][1], 2);
     }
-    const size_t clusters = (cnt[0] > 0) + (cnt[1] > 0);
+    const size_t clusters = (size_t)(cnt[0] > 0) + (size_t)(cnt[1] > 0);
     if (n > clusters) {
         out->sigma_mm = sqrt(ss / (double)(n - clusters));
         const double per_dir = (double)n / (double)clusters;

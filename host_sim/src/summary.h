@@ -7,12 +7,12 @@
 #include <stddef.h>
 
 typedef struct {
-    unsigned run;        ///< run number within its direction, from 1
-    int      ccw;        ///< 1 ccw, 0 cw
-    double   x_abs_mm, y_abs_mm, theta_abs_deg;    ///< true (measured) return pose
-    double   x_calc_mm, y_calc_mm, theta_calc_deg; ///< what the firmware computed
-    double   ex_mm, ey_mm, etheta_deg;             ///< 000 Eq. 3.1: absolute - calculated
-    double   t_end_s;                              ///< simulated duration of the run
+    unsigned run;                                ///< run number within its direction, from 1
+    int ccw;                                     ///< 1 ccw, 0 cw
+    double x_abs_mm, y_abs_mm, theta_abs_deg;    ///< true (measured) return pose
+    double x_calc_mm, y_calc_mm, theta_calc_deg; ///< what the firmware computed
+    double ex_mm, ey_mm, etheta_deg;             ///< 000 Eq. 3.1: absolute - calculated
+    double t_end_s;                              ///< simulated duration of the run
 } sim_return_t;
 
 typedef struct {

@@ -27,7 +27,8 @@ static double uniform01(uint64_t *s) { return (double)(splitmix64(s) >> 11) * (1
 #if defined(__GNUC__)
 __attribute__((format(printf, 3, 4)))
 #endif
-static int fail(char *err, size_t errlen, const char *fmt, ...)
+static int
+fail(char *err, size_t errlen, const char *fmt, ...)
 {
     if (err != NULL && errlen > 0) {
         va_list ap;
@@ -54,10 +55,7 @@ static bool eff_on(const sim_world_t *w, sim_effect_id_t id, unsigned t)
     return sim_scenario_enabled_on(&w->sc, id, t);
 }
 
-static double eff_p(const sim_world_t *w, sim_effect_id_t id, unsigned t, size_t k)
-{
-    return w->sc.eff[id][t].p[k];
-}
+static double eff_p(const sim_world_t *w, sim_effect_id_t id, unsigned t, size_t k) { return w->sc.eff[id][t].p[k]; }
 
 static unsigned n_trucks(const sim_world_t *w) { return w->robot.n_trucks; }
 
@@ -77,7 +75,8 @@ static int truck_radii(sim_world_t *w, unsigned t, char *err, size_t errlen)
     ts->counts_per_rev = sim_robot_counts_per_rev(d);
     ts->b_true_mm = d->wheelbase_mm * (eff_on(w, SIM_EFFECT_EB, t) ? eff_p(w, SIM_EFFECT_EB, t, SIM_P_EB_VALUE) : 1.0);
     /* 000 App. B: Es = L_calc/L_actual, so the true mean diameter is Dn / Es. */
-    const double d_mean = d->wheel_diameter_mm / (eff_on(w, SIM_EFFECT_ES, t) ? eff_p(w, SIM_EFFECT_ES, t, SIM_P_ES_VALUE) : 1.0);
+    const double d_mean =
+        d->wheel_diameter_mm / (eff_on(w, SIM_EFFECT_ES, t) ? eff_p(w, SIM_EFFECT_ES, t, SIM_P_ES_VALUE) : 1.0);
     /* 000 Eqs. 6.30-6.32: Ed = DR/DL with the mean kept: DL = 2 Da/(Ed + 1), DR = 2 Da/(1/Ed + 1). */
     const double ed = eff_on(w, SIM_EFFECT_ED, t) ? eff_p(w, SIM_EFFECT_ED, t, SIM_P_ED_VALUE) : 1.0;
     double r[2] = {d_mean / (ed + 1.0), d_mean / (1.0 / ed + 1.0)};
@@ -87,8 +86,10 @@ static int truck_radii(sim_world_t *w, unsigned t, char *err, size_t errlen)
         const double off = eff_p(w, SIM_EFFECT_TIRE_COMPRESSION, t, SIM_P_TIRE_OFFSET);
         const double b = d->wheelbase_mm;
         if (fabs(off) >= 0.5 * b) {
-            return fail(err, errlen, "tire_compression.lateral_offset_mm: |%g| must be below half the "
-                        "wheelbase of truck %c (%g mm)", off, (char)('A' + t), 0.5 * b);
+            return fail(err, errlen,
+                        "tire_compression.lateral_offset_mm: |%g| must be below half the "
+                        "wheelbase of truck %c (%g mm)",
+                        off, (char)('A' + t), 0.5 * b);
         }
         /* Static lever rule: the load sits `off` left of the centre. */
         r[ODO_LEFT] -= k * m * (0.5 * b + off) / b;
@@ -113,8 +114,8 @@ static double rough_gap(sim_world_t *w, unsigned t, sim_wheel_state_t *ws)
     return spacing * (1.0 + jitter * (2.0 * uniform01(&ws->rng) - 1.0));
 }
 
-int sim_world_init(sim_world_t *w, const sim_robot_t *robot, const sim_scenario_t *sc, uint64_t seed,
-                   char *err, size_t errlen)
+int sim_world_init(sim_world_t *w, const sim_robot_t *robot, const sim_scenario_t *sc, uint64_t seed, char *err,
+                   size_t errlen)
 {
     if (w == NULL || robot == NULL || sc == NULL) {
         return fail(err, errlen, "sim_world_init: NULL argument");
@@ -150,8 +151,8 @@ int sim_world_init(sim_world_t *w, const sim_robot_t *robot, const sim_scenario_
             continue;
         }
         if (sim_world_add_bump(w, b->truck, b->wheel, b->distance_mm, b->height_mm) != 0) {
-            return fail(err, errlen, "scenario bump %zu (height %g mm at %g mm) does not fit under truck %c's wheel",
-                        i, b->height_mm, b->distance_mm, (char)('A' + b->truck));
+            return fail(err, errlen, "scenario bump %zu (height %g mm at %g mm) does not fit under truck %c's wheel", i,
+                        b->height_mm, b->distance_mm, (char)('A' + b->truck));
         }
     }
     sim_world_place(w, 0.0, 0.0, 0.0);
@@ -333,8 +334,8 @@ int sim_world_set_hidden(sim_world_t *w, const sim_hidden_t *h, char *err, size_
     if (w == NULL || h == NULL) {
         return fail(err, errlen, "sim_world_set_hidden: NULL argument");
     }
-    const double v[5] = {h->motor_tau_s, fabs(h->diam_var_amp), h->diam_var_period_s,
-                         fabs(h->diam_drift_per_s), h->backlash_rad};
+    const double v[5] = {h->motor_tau_s, fabs(h->diam_var_amp), h->diam_var_period_s, fabs(h->diam_drift_per_s),
+                         h->backlash_rad};
     for (size_t i = 0; i < 5; ++i) {
         if (!isfinite(v[i]) || v[i] < 0.0) {
             return fail(err, errlen, "hidden effect %zu: %g is not a finite non-negative value", i, v[i]);
@@ -402,13 +403,13 @@ static void step_driven(sim_world_t *w, unsigned t, double dt, const double cmd_
     }
     double lateral = 0.0;
     if (eff_on(w, SIM_EFFECT_SKID, t)) {
-        const double v = 0.5 * (du[0] + du[1]) / dt;               /* mm/s */
-        const double om = (du[1] - du[0]) / ts->b_true_mm / dt;     /* rad/s */
-        const double ac = v * om * 1e-3;                            /* m/s^2, + centre on the left */
+        const double v = 0.5 * (du[0] + du[1]) / dt;            /* mm/s */
+        const double om = (du[1] - du[0]) / ts->b_true_mm / dt; /* rad/s */
+        const double ac = v * om * 1e-3;                        /* m/s^2, + centre on the left */
         const double a0 = eff_p(w, SIM_EFFECT_SKID, t, SIM_P_SKID_A0);
         if (fabs(ac) > a0) {
             const double vlat = eff_p(w, SIM_EFFECT_SKID, t, SIM_P_SKID_K) * (fabs(ac) - a0) * 1e3; /* mm/s */
-            lateral = (ac > 0.0 ? -vlat : vlat) * dt;               /* outward, away from the centre */
+            lateral = (ac > 0.0 ? -vlat : vlat) * dt; /* outward, away from the centre */
         }
     }
     move_truck(ts, du[0], du[1], lateral);
@@ -571,8 +572,8 @@ sim_link_reading_t sim_world_link_measured(const sim_world_t *w)
         r.length_mm += eff_p(w, SIM_EFFECT_LINK_BIAS, 0U, SIM_P_LINK_CONST) +
                        eff_p(w, SIM_EFFECT_LINK_BIAS, 0U, SIM_P_LINK_ECC) * (1.0 - cos(g.alpha_rad - g.beta_rad));
     }
-    const unsigned bits = w->robot.link.rotary_bits >= 1U && w->robot.link.rotary_bits <= 16U
-                              ? w->robot.link.rotary_bits : 16U;
+    const unsigned bits =
+        w->robot.link.rotary_bits >= 1U && w->robot.link.rotary_bits <= 16U ? w->robot.link.rotary_bits : 16U;
     r.alpha_bam16 = quantise_bam16(r.alpha_rad, bits);
     r.beta_bam16 = quantise_bam16(r.beta_rad, bits);
     const double res = w->robot.link.linear_resolution_mm > 0.0 ? w->robot.link.linear_resolution_mm : 0.001;

@@ -44,11 +44,11 @@
 #include "effects.h"
 #include "robot.h"
 
-#define SIM_WORLD_DEFAULT_DT_S  0.001 ///< 1 ms physics step
-#define SIM_WORLD_MAX_DT_S      0.1   ///< larger steps are refused
-#define SIM_WORLD_MAX_PENDING   64    ///< discrete bumps waiting under one wheel
-#define SIM_WORLD_MAX_ACTIVE    16    ///< bumps under one wheel at the same time
-#define SIM_WORLD_MAX_EVENTS    512   ///< bump events kept (later ones are counted, not kept)
+#define SIM_WORLD_DEFAULT_DT_S 0.001 ///< 1 ms physics step
+#define SIM_WORLD_MAX_DT_S     0.1   ///< larger steps are refused
+#define SIM_WORLD_MAX_PENDING  64    ///< discrete bumps waiting under one wheel
+#define SIM_WORLD_MAX_ACTIVE   16    ///< bumps under one wheel at the same time
+#define SIM_WORLD_MAX_EVENTS   512   ///< bump events kept (later ones are counted, not kept)
 
 typedef struct {
     double x_mm, y_mm; ///< truck centre (set trailer: axle centre)
@@ -57,11 +57,11 @@ typedef struct {
 
 /// A discrete bump reached by a wheel (roughness grains are not logged).
 typedef struct {
-    double  t_s;            ///< simulation time of first contact
-    uint8_t truck, wheel;   ///< ODO_TRUCK_*, ODO_LEFT / ODO_RIGHT
-    double  x_mm, y_mm;     ///< wheel contact point at first contact
-    double  height_mm;
-    double  at_distance_mm; ///< the wheel's travel when it was reached
+    double t_s;           ///< simulation time of first contact
+    uint8_t truck, wheel; ///< ODO_TRUCK_*, ODO_LEFT / ODO_RIGHT
+    double x_mm, y_mm;    ///< wheel contact point at first contact
+    double height_mm;
+    double at_distance_mm; ///< the wheel's travel when it was reached
 } sim_bump_event_t;
 
 /// True linkage geometry.
@@ -75,16 +75,16 @@ typedef struct {
 /// What the linkage encoders report: truth plus rotary_bias / link_bias, then quantised to the
 /// encoders' resolution (rounded: code k covers k +- half a step), in the firmware's units.
 typedef struct {
-    double   alpha_rad, beta_rad; ///< biased, before quantisation
-    double   length_mm;           ///< biased, before quantisation (set: trailer_length)
-    uint16_t alpha_bam16;         ///< quantised to rotary_bits, as 2^16 per turn
+    double alpha_rad, beta_rad; ///< biased, before quantisation
+    double length_mm;           ///< biased, before quantisation (set: trailer_length)
+    uint16_t alpha_bam16;       ///< quantised to rotary_bits, as 2^16 per turn
     uint16_t beta_bam16;
-    uint32_t length_um;           ///< quantised to linear_resolution_mm
+    uint32_t length_um; ///< quantised to linear_resolution_mm
 } sim_link_reading_t;
 
 typedef struct {
     sim_bump_geom_t g;
-    double          progress_mm; ///< rotation arc (driven wheel) or horizontal (passive) so far
+    double progress_mm; ///< rotation arc (driven wheel) or horizontal (passive) so far
 } sim_active_bump_t;
 
 /// Hidden effects: truth the effects catalog deliberately does not list, so the diagnosis has no
@@ -93,53 +93,55 @@ typedef struct {
 /// set only through sim_world_set_hidden (libodosim: odosim_run_ex). All zero = off, and then the
 /// world is bit-identical to a world without this struct. Driven wheels only.
 typedef struct {
-    double motor_tau_s;        ///< first-order lag of each wheel's speed behind its command (s)
-    double diam_var_amp;       ///< time-varying wheel diameter: D(t) = D (1 + amp sin(2 pi t / T))
-    double diam_var_period_s;  ///< T of the above (s); both wheels of a truck in phase
-    double diam_drift_per_s;   ///< and/or a linear drift D(t) = D (1 + drift t) (tyre warming)
-    double backlash_rad;       ///< gear backlash at the wheel: after a reversal the motor (and its
-                               ///< encoder) turns this much before the wheel follows
+    double motor_tau_s;       ///< first-order lag of each wheel's speed behind its command (s)
+    double diam_var_amp;      ///< time-varying wheel diameter: D(t) = D (1 + amp sin(2 pi t / T))
+    double diam_var_period_s; ///< T of the above (s); both wheels of a truck in phase
+    double diam_drift_per_s;  ///< and/or a linear drift D(t) = D (1 + drift t) (tyre warming)
+    double backlash_rad;      ///< gear backlash at the wheel: after a reversal the motor (and its
+                              ///< encoder) turns this much before the wheel follows
 } sim_hidden_t;
 
 typedef struct {
-    double   radius_mm;     ///< true rolling radius
-    double   phase_rad;     ///< cumulative rotation angle, forward positive
-    double   odometer_mm;   ///< cumulative |horizontal travel| of the contact point
-    double   cmd_prev_mm_s; ///< last command (slip)
-    double   v_motor_mm_s;  ///< hidden motor lag: the wheel's actual surface speed command
-    double   play_rad;      ///< hidden backlash: position in the gear play, [0, backlash]
-    size_t   n_pending;
-    struct { double at_mm, height_mm; } pending[SIM_WORLD_MAX_PENDING]; ///< ascending at_mm
-    size_t   n_active;
+    double radius_mm;     ///< true rolling radius
+    double phase_rad;     ///< cumulative rotation angle, forward positive
+    double odometer_mm;   ///< cumulative |horizontal travel| of the contact point
+    double cmd_prev_mm_s; ///< last command (slip)
+    double v_motor_mm_s;  ///< hidden motor lag: the wheel's actual surface speed command
+    double play_rad;      ///< hidden backlash: position in the gear play, [0, backlash]
+    size_t n_pending;
+    struct {
+        double at_mm, height_mm;
+    } pending[SIM_WORLD_MAX_PENDING]; ///< ascending at_mm
+    size_t n_active;
     sim_active_bump_t active[SIM_WORLD_MAX_ACTIVE];
-    double   next_rough_mm; ///< odometer reading of the next roughness grain
-    uint64_t rng;           ///< splitmix64 state of this wheel's roughness stream
+    double next_rough_mm; ///< odometer reading of the next roughness grain
+    uint64_t rng;         ///< splitmix64 state of this wheel's roughness stream
 } sim_wheel_state_t;
 
 typedef struct {
-    sim_pose_t        pose;
-    double            b_true_mm;      ///< Eb * nominal
-    double            r_nominal_mm;   ///< what the controller believes
-    double            counts_per_rev; ///< decoded counts per wheel turn
-    sim_bump_model_t  bump_model;     ///< discrete bumps on this truck
-    sim_bump_model_t  rough_model;    ///< roughness grains on this truck
+    sim_pose_t pose;
+    double b_true_mm;             ///< Eb * nominal
+    double r_nominal_mm;          ///< what the controller believes
+    double counts_per_rev;        ///< decoded counts per wheel turn
+    sim_bump_model_t bump_model;  ///< discrete bumps on this truck
+    sim_bump_model_t rough_model; ///< roughness grains on this truck
     sim_wheel_state_t wheel[2];
 } sim_truck_state_t;
 
 /// Treat as opaque; use the functions below.
 typedef struct {
-    sim_robot_t       robot;
-    sim_scenario_t    sc;
-    uint64_t          seed;
-    double            t_s;
+    sim_robot_t robot;
+    sim_scenario_t sc;
+    uint64_t seed;
+    double t_s;
     sim_truck_state_t truck[ODO_TRUCKS];
-    sim_hidden_t      hidden;         ///< out-of-catalog truth (all zero: off)
-    unsigned long     link_clamps;    ///< steps in which the clapper linkage hit a stop
-    bool              clamped_last;   ///< the last step did
-    unsigned long     bumps_dropped;  ///< bumps lost to full queues (should stay 0)
-    unsigned long     events_dropped; ///< events beyond SIM_WORLD_MAX_EVENTS
-    size_t            n_events;
-    sim_bump_event_t  events[SIM_WORLD_MAX_EVENTS];
+    sim_hidden_t hidden;          ///< out-of-catalog truth (all zero: off)
+    unsigned long link_clamps;    ///< steps in which the clapper linkage hit a stop
+    bool clamped_last;            ///< the last step did
+    unsigned long bumps_dropped;  ///< bumps lost to full queues (should stay 0)
+    unsigned long events_dropped; ///< events beyond SIM_WORLD_MAX_EVENTS
+    size_t n_events;
+    sim_bump_event_t events[SIM_WORLD_MAX_EVENTS];
 } sim_world_t;
 
 /// Set up the world at rest: truck A at the origin heading +x, B (clapper) l behind it, or the
@@ -148,8 +150,8 @@ typedef struct {
 /// seeded from `seed` (the caller decides between the scenario's seed and a --seed override).
 /// Returns 0, or -1 with a message for a NULL argument, a tyre load offset beyond b/2, a radius that
 /// compression makes non-positive, or a scenario bump the vehicle cannot take.
-int sim_world_init(sim_world_t *w, const sim_robot_t *robot, const sim_scenario_t *sc, uint64_t seed,
-                   char *err, size_t errlen);
+int sim_world_init(sim_world_t *w, const sim_robot_t *robot, const sim_scenario_t *sc, uint64_t seed, char *err,
+                   size_t errlen);
 
 /// Switch the hidden (out-of-catalog) effects on; call after sim_world_init, before stepping.
 /// Returns 0, or -1 with a message for a negative or non-finite value, |amp| or |drift t| that
@@ -170,8 +172,7 @@ int sim_world_step(sim_world_t *w, double dt_s, const double wheel_speed_cmd_mm_
 /// reaches at_distance_mm. Works whether or not the scenario enables "bumps" (experiments place
 /// their own); the profile model is the scenario's bumps model for that truck. Returns 0, or -1 for
 /// a bad truck/wheel, h outside [0, R), a non-finite distance or a full queue.
-int sim_world_add_bump(sim_world_t *w, unsigned truck, unsigned wheel, double at_distance_mm,
-                       double height_mm);
+int sim_world_add_bump(sim_world_t *w, unsigned truck, unsigned wheel, double at_distance_mm, double height_mm);
 
 /// True pose of a truck (B of a labmate: all zero).
 sim_pose_t sim_world_pose(const sim_world_t *w, unsigned truck);

@@ -110,14 +110,13 @@ START_TEST(linkage_encoders_are_quantised_to_10_bits_and_0_1_mm)
 {
     /* 004 section 2: two 10-bit absolute rotary encoders (0.35 deg steps), 0.1 mm linear. */
     boot(2U, true);
-    const uint8_t all = ODO_LINK_STATUS_ALPHA_VALID | ODO_LINK_STATUS_BETA_VALID |
-                        ODO_LINK_STATUS_LENGTH_VALID;
+    const uint8_t all = ODO_LINK_STATUS_ALPHA_VALID | ODO_LINK_STATUS_BETA_VALID | ODO_LINK_STATUS_LENGTH_VALID;
     odo_link_input_t l;
     ck_assert(hal_sim_set_link(&hal, deg(0.35), deg(0.36), 1000.09, all));
     ck_assert(hal_link_read(&hal, &l));
     ck_assert(l.rotary_present && l.linear_present);
-    ck_assert_uint_eq(0U, l.alpha_bam16);  /* below one step of 360/1024 = 0.3516 deg */
-    ck_assert_uint_eq(64U, l.beta_bam16);  /* one step: code 1 << 6 */
+    ck_assert_uint_eq(0U, l.alpha_bam16); /* below one step of 360/1024 = 0.3516 deg */
+    ck_assert_uint_eq(64U, l.beta_bam16); /* one step: code 1 << 6 */
     ck_assert_uint_eq(1000000U, l.length_um);
     ck_assert_uint_eq(all, l.rotary_status | l.linear_status);
     ck_assert_uint_eq(1U, l.rotary_seq);
@@ -207,9 +206,9 @@ END_TEST
 /// decoder's limit); returns every wheel sample and frame in `log`.
 typedef struct {
     odo_wheel_input_t wheel[250][2];
-    odo_can_frame_t   frames[250 * 8];
-    uint32_t          n_frames;
-    odo_pose_t        pose;
+    odo_can_frame_t frames[250 * 8];
+    uint32_t n_frames;
+    odo_pose_t pose;
 } run_log_t;
 
 static void scripted_run(run_log_t *log)
@@ -237,10 +236,9 @@ static void scripted_run(run_log_t *log)
             }
         }
         hal_sim_set_time_us(&hal, (uint64_t)(tick + 1) * 40000U);
-        ck_assert(hal_sim_set_link(&hal, deg(ts_rng_uniform(&r, -5, 5)),
-                                   deg(ts_rng_uniform(&r, -5, 5)), ts_rng_uniform(&r, 990, 1010),
-                                   ODO_LINK_STATUS_ALPHA_VALID | ODO_LINK_STATUS_BETA_VALID |
-                                       ODO_LINK_STATUS_LENGTH_VALID));
+        ck_assert(hal_sim_set_link(
+            &hal, deg(ts_rng_uniform(&r, -5, 5)), deg(ts_rng_uniform(&r, -5, 5)), ts_rng_uniform(&r, 990, 1010),
+            ODO_LINK_STATUS_ALPHA_VALID | ODO_LINK_STATUS_BETA_VALID | ODO_LINK_STATUS_LENGTH_VALID));
         odo_tick_output_t out;
         odo_tick_input_t loop_in;
         odo_loop_tick(&app, &hal, &loop_in, &out);
@@ -267,7 +265,7 @@ START_TEST(firmware_runs_on_emulated_counters_and_identical_runs_read_identicall
     ck_assert_uint_gt(a.n_frames, 250U);
     ck_assert_uint_eq(a.n_frames, b.n_frames);
     ck_assert_mem_eq(&a, &b, sizeof a);
-    ck_assert_int_gt(a.pose.x_mm_q32, 0); /* the truck went forward */
+    ck_assert_int_gt(a.pose.x_mm_q32, 0);          /* the truck went forward */
     ck_assert_uint_gt(a.wheel[249][0].status, 0U); /* the bursts left skipped states */
 }
 END_TEST

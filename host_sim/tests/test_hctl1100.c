@@ -11,8 +11,7 @@
 #include "hctl1100.h"
 #include "test_support.h"
 
-static odosim_hctl_t make(odosim_hctl_conv_t conv, uint32_t f_clk_hz, bool force_per_edge,
-                          double phase0)
+static odosim_hctl_t make(odosim_hctl_conv_t conv, uint32_t f_clk_hz, bool force_per_edge, double phase0)
 {
     odosim_hctl_t h;
     const odosim_hctl_config_t cfg = {f_clk_hz, conv, force_per_edge};
@@ -63,7 +62,7 @@ START_TEST(position_wraps_at_24_bits_both_ways)
 {
     /* HCTL-1100 "Actual Position Registers R12H-R14H": 24-bit two's complement, wraps. */
     odosim_hctl_t h = make(ODOSIM_HCTL_CONV_1100, 2000000U, false, 0.5);
-    const double top = 8388608.0; /* 2^23 */
+    const double top = 8388608.0;                         /* 2^23 */
     ck_assert(odosim_hctl_advance(&h, 100.0, top - 2.5)); /* 84 kstates/s: fast path */
     ck_assert_uint_eq(0x7FFFFDU, odosim_hctl_read_position(&h));
     uint32_t last = odosim_hctl_read_position(&h);
@@ -103,8 +102,8 @@ START_TEST(fast_path_and_per_edge_path_count_identically)
             /* Rates from standstill to twice the fast-path limit, either way, with reversals
              * that put successive edges arbitrarily close across a step boundary. */
             const double limit = (double)f / ODOSIM_HCTL_FAST_PERIODS;
-            const double rate = ts_rng_uniform(&r, -2.0, 2.0) * limit *
-                                (step % 7 == 0 ? 1.0 : ts_rng_uniform(&r, 0.0, 0.5));
+            const double rate =
+                ts_rng_uniform(&r, -2.0, 2.0) * limit * (step % 7 == 0 ? 1.0 : ts_rng_uniform(&r, 0.0, 0.5));
             const double dt = (step % 5 == 0) ? ts_rng_uniform(&r, 1e-6, 1e-4) : 1e-3;
             t += dt;
             p += rate * dt;
@@ -212,8 +211,8 @@ START_TEST(torn_read_when_upper_bytes_are_read_before_r14h)
     /* Right order: R14H latches, the count moves on, R13H and R12H still give the latched
      * count: the value is the position at the R14H read, not a mix. */
     ck_assert_uint_eq(0x000100U, odosim_hctl_read_position(&h)); /* also releases the latch */
-    ck_assert(odosim_hctl_advance(&h, 2.0, 0.5)); /* back to 0x0000 (256 counts) */
-    ck_assert(odosim_hctl_advance(&h, 3.0, 255.5)); /* 0x00FF */
+    ck_assert(odosim_hctl_advance(&h, 2.0, 0.5));                /* back to 0x0000 (256 counts) */
+    ck_assert(odosim_hctl_advance(&h, 3.0, 255.5));              /* 0x00FF */
     const uint32_t l2 = odosim_hctl_read(&h, ODOSIM_HCTL_REG_ACT_POS_LSB);
     ck_assert(odosim_hctl_advance(&h, 4.0, 256.5)); /* 0x0100 while the read is under way */
     const uint32_t m2 = odosim_hctl_read(&h, ODOSIM_HCTL_REG_ACT_POS_MID);

@@ -18,15 +18,12 @@
 #error "ODOSIM_SOURCE_DIR must point at host_sim/"
 #endif
 
-#define DEG(rad) ((rad) * 180.0 / M_PI)
+#define DEG(rad) ((rad)*180.0 / M_PI)
 #define DT       SIM_WORLD_DEFAULT_DT_S
 
 static sim_world_t g_world, g_world2; /* ~36 KiB each: kept off the stack */
 
-static void must(int rc, const char *err)
-{
-    ck_assert_msg(rc == 0, "%s", err);
-}
+static void must(int rc, const char *err) { ck_assert_msg(rc == 0, "%s", err); }
 
 static void load_robot(const char *name, sim_robot_t *r)
 {
@@ -165,7 +162,8 @@ START_TEST(straight_run_over_one_bump_turns_toward_the_bumped_wheel_by_dtheta)
         const double y0 = after.y_mm;
         straight(&g_world, 10000.0);
         const double dy = sim_world_pose(&g_world, 0).y_mm - y0;
-        ck_assert_double_eq_tol(dy, -sim_bump_elat_mm(g.dd_mm, 340.0, 10000.0), 0.01 * sim_bump_elat_mm(g.dd_mm, 340.0, 10000.0));
+        ck_assert_double_eq_tol(dy, -sim_bump_elat_mm(g.dd_mm, 340.0, 10000.0),
+                                0.01 * sim_bump_elat_mm(g.dd_mm, 340.0, 10000.0));
         /* The encoder still counted the full rotation: both wheels show the same phase. */
         ck_assert_double_eq_tol(sim_world_encoder_phase_counts(&g_world, 0, ODO_LEFT),
                                 sim_world_encoder_phase_counts(&g_world, 0, ODO_RIGHT), 1e-6);
@@ -196,8 +194,7 @@ START_TEST(ed_above_one_makes_a_straight_command_curve_left)
         /* 000 Eq. 6.30: the mean diameter is kept, so the centre travels an arc of exactly 4 m; the
          * straight-line distance is that arc's chord. */
         const double chord = 4000.0 * sin(0.5 * expect) / (0.5 * expect);
-        ck_assert_double_eq_tol(hypot(sim_world_pose(&g_world, 0).x_mm, sim_world_pose(&g_world, 0).y_mm),
-                                chord, 1e-6);
+        ck_assert_double_eq_tol(hypot(sim_world_pose(&g_world, 0).x_mm, sim_world_pose(&g_world, 0).y_mm), chord, 1e-6);
     }
 }
 END_TEST
@@ -404,9 +401,9 @@ START_TEST(world_refuses_bad_steps_and_bumps)
     ck_assert_int_eq(sim_world_step(&g_world, DT, cmd), -1);
     ck_assert_int_eq(sim_world_step(&g_world, 0.0, ok), -1);
     ck_assert_int_eq(sim_world_step(&g_world, 1.0, ok), -1);
-    ck_assert_int_eq(sim_world_add_bump(&g_world, 1, 0, 10.0, 1.0), -1); /* labmate has no truck B */
+    ck_assert_int_eq(sim_world_add_bump(&g_world, 1, 0, 10.0, 1.0), -1);  /* labmate has no truck B */
     ck_assert_int_eq(sim_world_add_bump(&g_world, 0, 0, 10.0, 80.0), -1); /* higher than the wheel */
-    ck_assert(sim_world_pose(&g_world, 0).x_mm == 0.0); /* refused steps did not move it */
+    ck_assert(sim_world_pose(&g_world, 0).x_mm == 0.0);                   /* refused steps did not move it */
     /* Tyre load offset beyond half the wheelbase. */
     must(sim_scenario_set(&sc, "tire_compression", "lateral_offset_mm", 3U, 200.0, err, sizeof err), err);
     ck_assert_int_eq(sim_world_init(&g_world, &r, &sc, 1U, err, sizeof err), -1);
@@ -423,7 +420,8 @@ START_TEST(tire_compression_with_an_offset_load_acts_like_an_ed)
     char err[256];
     load_scenario("effect-tire_compression", &sc);
     must(sim_world_init(&g_world, &r, &sc, 1U, err, sizeof err), err);
-    const double rl = sim_world_wheel_radius_mm(&g_world, 0, ODO_LEFT), rr = sim_world_wheel_radius_mm(&g_world, 0, ODO_RIGHT);
+    const double rl = sim_world_wheel_radius_mm(&g_world, 0, ODO_LEFT),
+                 rr = sim_world_wheel_radius_mm(&g_world, 0, ODO_RIGHT);
     ck_assert(rr > rl && rl < 75.0);
     straight(&g_world, 4000.0);
     ck_assert(sim_world_pose(&g_world, 0).theta_rad > 0.0);
@@ -517,7 +515,8 @@ START_TEST(bad_scenarios_are_refused_with_the_file_effect_and_parameter_named)
     must(sim_scenario_parse_string("{\"seed\": 9, \"bump_model\": \"paper\", \"effects\": {"
                                    "\"ed\": [{\"truck\": \"A\", \"value\": 1.01}, {\"truck\": \"B\", \"value\": 0.99}],"
                                    "\"es\": {\"value\": 1.01, \"enabled\": false}}}",
-                                   "ok.json", &sc, err, sizeof err), err);
+                                   "ok.json", &sc, err, sizeof err),
+         err);
     ck_assert(sc.has_seed && sc.seed == 9U);
     ck_assert(sim_scenario_enabled_on(&sc, SIM_EFFECT_ED, 0) && sim_scenario_enabled_on(&sc, SIM_EFFECT_ED, 1));
     ck_assert_double_eq(sim_scenario_param(&sc, SIM_EFFECT_ED, 1, 0), 0.99);
@@ -566,7 +565,8 @@ START_TEST(robot_descriptions_convert_to_parameter_blocks_the_firmware_accepts)
     must(sim_robot_parse_string("{\"vehicle\": \"labmate\", \"trucks\": {\"A\": {\"wheel_diameter_mm\": 150, "
                                 "\"wheelbase_mm\": 340, \"encoder_lines\": 500, \"gear_ratio\": 19.5, "
                                 "\"calibration\": {\"ed\": 1.0015, \"eb\": 0.99}}}}",
-                                "cal.json", &r, err, sizeof err), err);
+                                "cal.json", &r, err, sizeof err),
+         err);
     must(sim_robot_to_params(&r, &p, err, sizeof err), err);
     ck_assert_int_eq(p.truck[0].ed_q30, (int32_t)llround(1.0015 * 1073741824.0));
     ck_assert_int_eq(p.truck[0].eb_q30, (int32_t)llround(0.99 * 1073741824.0));
@@ -577,14 +577,16 @@ START_TEST(robot_descriptions_convert_to_parameter_blocks_the_firmware_accepts)
     must(sim_robot_parse_string("{\"vehicle\": \"labmate\", \"trucks\": {\"A\": {\"wheel_diameter_mm\": 150, "
                                 "\"wheelbase_mm\": 340, \"encoder_lines\": 500, \"gear_ratio\": 19.5, "
                                 "\"calibration\": {\"eb\": 1.0065, \"scrub\": -0.0095}}}}",
-                                "scrub.json", &r, err, sizeof err), err);
+                                "scrub.json", &r, err, sizeof err),
+         err);
     must(sim_robot_to_params(&r, &p, err, sizeof err), err);
     ck_assert_int_eq(p.truck[0].scrub_q30, (int32_t)llround(-0.0095 * 1073741824.0));
     ck_assert_int_eq(p.truck[0].eb_q30, (int32_t)llround(1.0065 * 1073741824.0));
     ck_assert_int_ne(sim_robot_parse_string("{\"vehicle\": \"labmate\", \"trucks\": {\"A\": {\"wheel_diameter_mm\": "
                                             "150, \"wheelbase_mm\": 340, \"encoder_lines\": 500, \"gear_ratio\": "
                                             "19.5, \"calibration\": {\"scrub\": 0.3}}}}",
-                                            "scrub.json", &r, err, sizeof err), 0);
+                                            "scrub.json", &r, err, sizeof err),
+                     0);
     ck_assert_ptr_nonnull(strstr(err, "trucks.A.calibration.scrub"));
     load_robot("labmate", &r);
     r.truck[0].cal_scrub = -0.26; /* built in code: caught by odo_params_validate, named */
@@ -624,7 +626,8 @@ START_TEST(bad_robot_descriptions_are_refused_with_the_field_named)
                        (const char *const[]){"trucks.A.encoder_lines", "expected an integer", NULL});
     expect_robot_error("{\"vehicle\": \"labmate\", \"trucks\": {\"A\": " TRUCK "}, \"B\": " TRUCK "}}}",
                        (const char *const[]){"trucks.B", "unknown key", NULL});
-    expect_robot_error("{\"vehicle\": \"clapper\", \"trucks\": {\"A\": " TRUCK "}, \"B\": " TRUCK ", \"counter_bits\": 16}}, "
+    expect_robot_error("{\"vehicle\": \"clapper\", \"trucks\": {\"A\": " TRUCK "}, \"B\": " TRUCK
+                       ", \"counter_bits\": 16}}, "
                        "\"linkage\": {\"length_mm\": 1000}}",
                        (const char *const[]){"trucks.B.counter_bits", "one counter width", NULL});
     expect_robot_error("{\"vehicle\": \"clapper\", \"trucks\": {\"A\": " TRUCK "}, \"B\": " TRUCK "}}}",
@@ -635,7 +638,8 @@ START_TEST(bad_robot_descriptions_are_refused_with_the_field_named)
                        (const char *const[]){"trailer", "only a set", NULL});
     expect_robot_error("{\"vehicle\": \"labmate\", \"tick_ms\": \"40\", \"trucks\": {\"A\": " TRUCK "}}}",
                        (const char *const[]){"tick_ms", "expected a number", NULL});
-    expect_robot_error("{\"vehicle\": \"labmate\" \"trucks\": {}}", (const char *const[]){"malformed JSON", "line 1", NULL});
+    expect_robot_error("{\"vehicle\": \"labmate\" \"trucks\": {}}",
+                       (const char *const[]){"malformed JSON", "line 1", NULL});
     sim_robot_t r;
     char err[512];
     ck_assert_int_eq(sim_robot_parse_file("/nonexistent/robot.json", &r, err, sizeof err), -1);
@@ -668,7 +672,4 @@ static Suite *suite(void)
     return s;
 }
 
-int main(void)
-{
-    return ts_run_suite(suite());
-}
+int main(void) { return ts_run_suite(suite()); }

@@ -71,8 +71,8 @@ START_TEST(log_start_whole_seconds_and_now)
 }
 END_TEST
 
-static const char *const BAD_START[] = {"", "-1", "+1", " 1", "1.5", "1e9", "abc", "NOW", "8589934593",
-                                        "99999999999999999999999", "12 "};
+static const char *const BAD_START[] = {
+    "", "-1", "+1", " 1", "1.5", "1e9", "abc", "NOW", "8589934593", "99999999999999999999999", "12 "};
 
 START_TEST(log_start_rejects_anything_else)
 {
@@ -111,7 +111,4 @@ static Suite *suite(void)
     return s;
 }
 
-int main(void)
-{
-    return ts_run_suite(suite());
-}
+int main(void) { return ts_run_suite(suite()); }

@@ -57,15 +57,15 @@ START_TEST(fixed_point_pose_matches_double_reference_after_1km)
         ck_assert_msg(r.heading_err_rad <= 1e-6, "run %d: %.3g rad", run, r.heading_err_rad);
     }
     ck_assert_msg(total_wraps > 12U, "the paths must cross counter wraps (%u)", total_wraps);
-    printf("fixed vs double after 1 km: worst position %.3g mm, worst heading %.3g rad, %u wraps\n",
-           worst_pos, worst_head, total_wraps);
+    printf("fixed vs double after 1 km: worst position %.3g mm, worst heading %.3g rad, %u wraps\n", worst_pos,
+           worst_head, total_wraps);
 }
 END_TEST
 
 /// Worst of `runs` 1 km runs of random trucks with scrub k (Q30), counters `bits` wide, both heading
 /// forms; asserts the requirement on each.
-static void scrub_runs(ts_rng_t *rng, int32_t k_q30, uint8_t bits, uint32_t counts_milli, int runs,
-                       double *worst_pos, double *worst_head, uint32_t *wraps)
+static void scrub_runs(ts_rng_t *rng, int32_t k_q30, uint8_t bits, uint32_t counts_milli, int runs, double *worst_pos,
+                       double *worst_head, uint32_t *wraps)
 {
     for (int run = 0; run < runs; ++run) {
         odo_truck_params_t tp = random_truck(rng);
@@ -98,7 +98,8 @@ START_TEST(fixed_point_pose_matches_double_reference_with_scrub_after_1km)
         scrub_runs(&rng, k, i % 2 ? 32U : 24U, 0U, 2, &worst_pos, &worst_head, &wraps);
     }
     printf("fixed vs double after 1 km with scrub k in [-0.25, 0.25]: worst position %.3g mm, worst heading "
-           "%.3g rad\n", worst_pos, worst_head);
+           "%.3g rad\n",
+           worst_pos, worst_head);
 }
 END_TEST
 
@@ -113,7 +114,8 @@ START_TEST(fixed_point_pose_matches_double_reference_with_8_and_12_bit_counters)
     scrub_runs(&rng, (int32_t)llround(0.0095 * 1073741824.0), 12U, 2000000U, 2, &worst_pos, &worst_head, &wraps);
     ck_assert_msg(wraps > 1000U, "narrow counters must wrap often (%u)", wraps);
     printf("fixed vs double after 1 km, 8/12-bit counters: worst position %.3g mm, worst heading %.3g rad, "
-           "%u wraps\n", worst_pos, worst_head, wraps);
+           "%u wraps\n",
+           worst_pos, worst_head, wraps);
 }
 END_TEST
 

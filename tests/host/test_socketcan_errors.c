@@ -14,8 +14,8 @@ START_TEST(missing_interface_is_a_clear_error)
     static hal_socketcan_t s;
     const uint32_t ids[] = {0x110U};
     ck_assert_int_eq(hal_socketcan_open(&s, "odonosuch0", ids, 1U), -1);
-    ck_assert_msg(strstr(s.err, "no SocketCAN") != NULL || strstr(s.err, "no interface 'odonosuch0'") != NULL,
-                  "%s", s.err);
+    ck_assert_msg(strstr(s.err, "no SocketCAN") != NULL || strstr(s.err, "no interface 'odonosuch0'") != NULL, "%s",
+                  s.err);
     if (strstr(s.err, "no SocketCAN") != NULL) {
         ck_assert_ptr_nonnull(strstr(s.err, "can_raw"));
     }

@@ -116,6 +116,13 @@ def test_bad_source_date_epoch_is_refused(tmp_path):
     assert r.returncode == 2 and "SOURCE_DATE_EPOCH" in r.stderr
     assert not (tmp_path / "out").exists()
 
+    # only where the default is used: --help and an explicit --log-start do not read it
+    h = subprocess.run([str(SIM), "--help"], capture_output=True, text=True,
+                       env={**os.environ, "SOURCE_DATE_EPOCH": "yesterday"})
+    assert h.returncode == 0 and "--log-start" in h.stdout
+    r = sim(tmp_path / "given", "--log-start", "0", env={**os.environ, "SOURCE_DATE_EPOCH": "yesterday"})
+    assert r.returncode == 0, r.stderr
+
 
 def test_gap_pairs_a_wall_clock_log_with_its_truth(runs):
     """odo-gap's readers take the log and the truth on one clock: the same run started at 0 or at

@@ -154,12 +154,13 @@ def test_bad_scenario_names_file_and_problem_and_leaves_nothing(tmp_path: Path) 
 def test_unwritable_output_and_foreign_folder_are_refused(tmp_path: Path) -> None:
     args = ["--experiment", "umbmark", "--vehicle", "labmate", "--scenario",
             str(SCEN / "none.json"), "--runs", "1"]
-    r = sim(tmp_path / "missing" / "out", *args, check=False)
-    assert r.returncode == 1 and "cannot create" in r.stderr
+    (tmp_path / "plain").write_text("a file, not a folder")
+    r = sim(tmp_path / "plain" / "out", *args, check=False)
+    assert r.returncode == 1 and "plain is not a folder" in r.stderr
     foreign = tmp_path / "out"
     foreign.mkdir()
     (foreign / "precious.txt").write_text("keep me")
     r = sim(foreign, *args, check=False)
-    assert r.returncode == 1 and "not a previous odo-sim output" in r.stderr
+    assert r.returncode == 1 and "non-empty folder odo-sim did not write" in r.stderr
     assert (foreign / "precious.txt").read_text() == "keep me"
-    assert [p.name for p in tmp_path.iterdir()] == ["out"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out", "plain"]

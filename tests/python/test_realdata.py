@@ -242,8 +242,8 @@ def test_header_map_radians_and_firmware_columns(tmp_path: Path) -> None:
     ("running_totals_as_increments", "faster than the robot's max_wheel_speed_mm_s"),
     ("not_a_number", ":7: not a number in column left"),
     ("directions", "--directions has 2 entries for 1 runs"),
-    ("out_is_input", "is (or holds) an input"),
-    ("out_not_ours", "was not written by odo-import"),
+    ("out_is_input", "non-empty folder odo-import did not write"),
+    ("out_not_ours", "non-empty folder odo-import did not write"),
 ])
 def test_import_bad_input(tmp_path: Path, case: str, expect: str) -> None:
     ticks, truth = drive("square", seed=2)
@@ -291,7 +291,7 @@ def test_import_bad_input(tmp_path: Path, case: str, expect: str) -> None:
         assert (out / "mine.txt").read_text() == "user data"
     elif case != "out_is_input":
         assert not out.exists()
-    assert not list(tmp_path.glob("o.tmp.*"))
+    assert not list(tmp_path.glob(".o.tmp-*")) and not list(tmp_path.glob("in/.*"))
 
 
 # --- odo-calib fit -----------------------------------------------------------------------------
@@ -370,7 +370,7 @@ def test_fit_from_return_poses_only(tmp_path: Path) -> None:
     ("glob", "'nothing*' matches no run"),
     ("backwards", "does not increase"),
     ("short_truth", "mismatched ticks/truth lengths"),
-    ("out_is_input", "is an input"),
+    ("out_is_input", "inside the input folder"),
 ])
 def test_fit_bad_input(synthetic, tmp_path: Path, case: str, expect: str) -> None:
     imp, robot = synthetic

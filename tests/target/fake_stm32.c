@@ -48,13 +48,11 @@ void fake_stm32_can_rx(uint32_t id, bool ext, bool rtr, uint8_t raw_dlc, const u
     m->dhr = (uint32_t)data[4] | ((uint32_t)data[5] << 8) | ((uint32_t)data[6] << 16) | ((uint32_t)data[7] << 24);
 }
 
-#define IN(block, reg) ((const volatile void *)(reg) >= (const volatile void *)&(block) && \
-                        (const volatile void *)(reg) < (const volatile void *)(&(block) + 1))
+#define IN(block, reg)                                                  \
+    ((const volatile void *)(reg) >= (const volatile void *)&(block) && \
+     (const volatile void *)(reg) < (const volatile void *)(&(block) + 1))
 
-static bool pin_low(const odo_stm32_gpio_t *g, uint8_t pin)
-{
-    return (g->ODR & (1UL << pin)) == 0U;
-}
+static bool pin_low(const odo_stm32_gpio_t *g, uint8_t pin) { return (g->ODR & (1UL << pin)) == 0U; }
 
 static int selected_chip(void)
 {
@@ -92,7 +90,7 @@ uint32_t odo_reg_read(const volatile uint32_t *reg)
     fake.reads++;
     if (reg == &fake.gpio[0].IDR) {
         const bool inputs = (fake.gpio[0].MODER & 0xFFFFU) == 0U;
-        return (fake.gpio[0].IDR & ~0xFFUL) | (fake.driving >= 0 && inputs ? fake.driven : 0U);
+        return (fake.gpio[0].IDR & ~(uint32_t)0xFFU) | (fake.driving >= 0 && inputs ? fake.driven : 0U);
     }
     if (reg == &fake.gpio[0].BSRR || reg == &fake.gpio[1].BSRR) {
         return 0U; /* write-only */
@@ -117,7 +115,7 @@ void odo_reg_write(volatile uint32_t *reg, uint32_t value)
     if (IN(fake.rcc, reg)) {
         *reg = value;
         odo_stm32_rcc_t *r = &fake.rcc;
-        uint32_t cr = r->CR & ~(ODO_RCC_CR_HSIRDY | ODO_RCC_CR_HSERDY | ODO_RCC_CR_PLLRDY);
+        uint32_t cr = r->CR & ~(uint32_t)(ODO_RCC_CR_HSIRDY | ODO_RCC_CR_HSERDY | ODO_RCC_CR_PLLRDY);
         cr |= (cr & ODO_RCC_CR_HSION) != 0U ? ODO_RCC_CR_HSIRDY : 0U;
         cr |= (cr & ODO_RCC_CR_HSEON) != 0U && fake.hse_works ? ODO_RCC_CR_HSERDY : 0U;
         cr |= (cr & ODO_RCC_CR_PLLON) != 0U && fake.pll_locks ? ODO_RCC_CR_PLLRDY : 0U;
@@ -125,7 +123,7 @@ void odo_reg_write(volatile uint32_t *reg, uint32_t value)
         const uint32_t sw = r->CFGR & ODO_RCC_CFGR_SW_MASK;
         const uint32_t ready[3] = {ODO_RCC_CR_HSIRDY, ODO_RCC_CR_HSERDY, ODO_RCC_CR_PLLRDY};
         if (sw < 3U && (cr & ready[sw]) != 0U) {
-            r->CFGR = (r->CFGR & ~ODO_RCC_CFGR_SWS_MASK) | ODO_RCC_CFGR_SWS(sw);
+            r->CFGR = (r->CFGR & ~(uint32_t)ODO_RCC_CFGR_SWS_MASK) | (uint32_t)ODO_RCC_CFGR_SWS(sw);
         }
         return;
     }
@@ -161,7 +159,7 @@ void odo_reg_write(volatile uint32_t *reg, uint32_t value)
     }
     if (reg == &fake.can.MCR) {
         fake.can.MCR = value;
-        uint32_t msr = fake.can.MSR & ~(ODO_CAN_MSR_INAK | ODO_CAN_MSR_SLAK);
+        uint32_t msr = fake.can.MSR & ~(uint32_t)(ODO_CAN_MSR_INAK | ODO_CAN_MSR_SLAK);
         if (!fake.can_no_clock) {
             const bool inrq = (value & ODO_CAN_MCR_INRQ) != 0U;
             msr |= (inrq || fake.can_stuck_in_init) ? ODO_CAN_MSR_INAK : 0U;
@@ -188,7 +186,7 @@ void odo_reg_write(volatile uint32_t *reg, uint32_t value)
             if ((value & ODO_CAN_TIR_TXRQ) != 0U && fake.txlog_len < FAKE_CAN_LOG) {
                 const odo_stm32_can_tx_t *mb = &fake.can.tx[m];
                 fake_can_mb_t *l = &fake.txlog[fake.txlog_len++];
-                l->ir = value & ~ODO_CAN_TIR_TXRQ;
+                l->ir = value & ~(uint32_t)ODO_CAN_TIR_TXRQ;
                 l->dtr = mb->TDTR;
                 l->dlr = mb->TDLR;
                 l->dhr = mb->TDHR;

@@ -30,12 +30,12 @@ typedef struct {
 } fake_can_mb_t;
 
 typedef struct {
-    odo_stm32_rcc_t   rcc;
+    odo_stm32_rcc_t rcc;
     odo_stm32_flash_t flash;
-    odo_stm32_gpio_t  gpio[2]; ///< [0]: HCTL data port, [1]: control port (also CAN/encoder pins)
-    odo_stm32_tim_t   tim[FAKE_TIMS];
-    odo_stm32_can_t   can;
-    odo_stm32_iwdg_t  iwdg;
+    odo_stm32_gpio_t gpio[2]; ///< [0]: HCTL data port, [1]: control port (also CAN/encoder pins)
+    odo_stm32_tim_t tim[FAKE_TIMS];
+    odo_stm32_can_t can;
+    odo_stm32_iwdg_t iwdg;
 
     /* What the "hardware" does. */
     bool hse_works;
@@ -45,23 +45,23 @@ typedef struct {
 
     /* Models. */
     fake_can_mb_t rxq[FAKE_CAN_QUEUE];
-    uint32_t      rxq_head, rxq_len;
-    bool          rx_overrun;
+    uint32_t rxq_head, rxq_len;
+    bool rx_overrun;
     fake_can_mb_t txlog[FAKE_CAN_LOG];
-    uint32_t      txlog_len;
-    bool          iwdg_unlocked, iwdg_started;
-    uint32_t      iwdg_reloads, iwdg_ignored_writes;
-    uint64_t      reads; ///< every odo_reg_read, to check that waits are bounded
+    uint32_t txlog_len;
+    bool iwdg_unlocked, iwdg_started;
+    uint32_t iwdg_reloads, iwdg_ignored_writes;
+    uint64_t reads; ///< every odo_reg_read, to check that waits are bounded
 
     /* HCTL-1100 chips on the GPIO bus (fake_stm32_hctl_attach). */
     odosim_hctl_t *chip[4];
-    uint8_t        n_chips;
-    uint8_t        ale_pin, oe_pin, cs_pin[4];
-    uint8_t        latched_addr[4];
-    int            driving;    ///< chip driving D0-D7, or -1
-    uint8_t        driven;
-    void         (*on_read)(void *user, uint8_t chip, uint8_t reg); ///< before each chip read
-    void          *user;
+    uint8_t n_chips;
+    uint8_t ale_pin, oe_pin, cs_pin[4];
+    uint8_t latched_addr[4];
+    int driving; ///< chip driving D0-D7, or -1
+    uint8_t driven;
+    void (*on_read)(void *user, uint8_t chip, uint8_t reg); ///< before each chip read
+    void *user;
 } fake_stm32_t;
 
 extern fake_stm32_t fake;

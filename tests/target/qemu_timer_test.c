@@ -10,8 +10,8 @@
 #include "odo_timer.h"
 #include "stm32f4_regs.h"
 
-#define PERIODS 3U
-#define SPIN_LIMIT 500000000UL
+#define PERIODS        3U
+#define SPIN_LIMIT     500000000UL
 /* qemu's model counts at 1 GHz / (PSC + 1) whatever the RCC says. Claiming a 4,294 MHz kernel
  * clock (PSC 4293) and the longest period (ARR 65535) makes a period 0.28 s of qemu time, so the
  * flag cannot come back between clearing it and checking that it is clear on a loaded host

@@ -25,8 +25,8 @@ int main(int argc, char **argv)
         printf("params_ok=%d params_err_magic=%d params_err_crc=%d fault_params_defaulted=%lu "
                "selftest_done=%lu clock_hsi=%d clock_hsi_hz=%lu bxcan_err_init_mode=%d\n",
                (int)ODO_PARAMS_OK, (int)ODO_PARAMS_ERR_MAGIC, (int)ODO_PARAMS_ERR_CRC,
-               (unsigned long)ODO_FAULT_PARAMS_DEFAULTED, (unsigned long)ODO_BOARD_SELFTEST_DONE,
-               (int)ODO_CLOCK_HSI, (unsigned long)ODO_CLOCK_HSI_HZ, (int)ODO_BXCAN_ERR_INIT_MODE);
+               (unsigned long)ODO_FAULT_PARAMS_DEFAULTED, (unsigned long)ODO_BOARD_SELFTEST_DONE, (int)ODO_CLOCK_HSI,
+               (unsigned long)ODO_CLOCK_HSI_HZ, (int)ODO_BXCAN_ERR_INIT_MODE);
         return 0;
     }
     if (argc != 2) {
@@ -50,8 +50,7 @@ int main(int argc, char **argv)
     odo_selftest_run(&app, &in, &out, block, len, &r);
     printf("params_status=%lu steps=%lu faults_or=0x%08lx frames=%lu x_mm_q32=%lld y_mm_q32=%lld "
            "heading_bam=0x%08lx done=0x%08lx\n",
-           (unsigned long)r.params_status, (unsigned long)r.steps, (unsigned long)r.faults_or,
-           (unsigned long)r.frames, (long long)r.x_mm_q32, (long long)r.y_mm_q32,
-           (unsigned long)r.heading_bam, (unsigned long)r.done);
+           (unsigned long)r.params_status, (unsigned long)r.steps, (unsigned long)r.faults_or, (unsigned long)r.frames,
+           (long long)r.x_mm_q32, (long long)r.y_mm_q32, (unsigned long)r.heading_bam, (unsigned long)r.done);
     return 0;
 }

@@ -28,10 +28,22 @@ void _fini(void);
 typedef void (*odo_isr_t)(void);
 
 /// Initial SP, then Reset .. SysTick (Armv7-M B1.5.3); no peripheral interrupt is used.
-__attribute__((section(".isr_vector"), used))
-static const odo_isr_t vectors[16] = {
-    (odo_isr_t)(uintptr_t)_estack, Reset_Handler, Fault_Handler, Fault_Handler, Fault_Handler,
-    Fault_Handler, Fault_Handler, 0, 0, 0, 0, Fault_Handler, Fault_Handler, 0, Fault_Handler,
+__attribute__((section(".isr_vector"), used)) static const odo_isr_t vectors[16] = {
+    (odo_isr_t)(uintptr_t)_estack,
+    Reset_Handler,
+    Fault_Handler,
+    Fault_Handler,
+    Fault_Handler,
+    Fault_Handler,
+    Fault_Handler,
+    0,
+    0,
+    0,
+    0,
+    Fault_Handler,
+    Fault_Handler,
+    0,
+    Fault_Handler,
     Fault_Handler,
 };
 

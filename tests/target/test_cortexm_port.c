@@ -24,10 +24,7 @@
 
 #define POLLS 1000U
 
-static void setup(void)
-{
-    fake_stm32_reset();
-}
+static void setup(void) { fake_stm32_reset(); }
 
 /* ---- clock ------------------------------------------------------------------------------- */
 
@@ -44,10 +41,10 @@ START_TEST(clock_168mhz_from_the_crystal)
     ck_assert_uint_eq(fake.rcc.PLLCFGR, 8UL | (336UL << 6) | (0UL << 16) | (1UL << 22) | (7UL << 24));
     ck_assert_uint_eq(fake.flash.ACR & 7U, 5U);
     ck_assert_uint_eq(fake.flash.ACR & 0x700U, 0x700U);
-    ck_assert_uint_eq((fake.rcc.CFGR >> 4) & 0xFU, 0U);  /* HPRE /1 */
-    ck_assert_uint_eq((fake.rcc.CFGR >> 10) & 7U, 5U);   /* PPRE1 /4 */
-    ck_assert_uint_eq((fake.rcc.CFGR >> 13) & 7U, 4U);   /* PPRE2 /2 */
-    ck_assert_uint_eq(fake.rcc.CFGR & 0xFU, 0xAU);       /* SW = SWS = PLL */
+    ck_assert_uint_eq((fake.rcc.CFGR >> 4) & 0xFU, 0U); /* HPRE /1 */
+    ck_assert_uint_eq((fake.rcc.CFGR >> 10) & 7U, 5U);  /* PPRE1 /4 */
+    ck_assert_uint_eq((fake.rcc.CFGR >> 13) & 7U, 4U);  /* PPRE2 /2 */
+    ck_assert_uint_eq(fake.rcc.CFGR & 0xFU, 0xAU);      /* SW = SWS = PLL */
 }
 END_TEST
 
@@ -248,8 +245,8 @@ static unsigned dbc_sensor_ids(uint32_t *ids, unsigned cap)
     while (fgets(line, sizeof line, f) != NULL) {
         unsigned id = 0, dlc = 0;
         char name[128], sender[128];
-        if (sscanf(line, "BO_ %u %127[^:]: %u %127s", &id, name, &dlc, sender) == 4 &&
-            strcmp(sender, "SENSOR") == 0 && n < cap) {
+        if (sscanf(line, "BO_ %u %127[^:]: %u %127s", &id, name, &dlc, sender) == 4 && strcmp(sender, "SENSOR") == 0 &&
+            n < cap) {
             ids[n++] = id;
         }
     }
@@ -264,8 +261,8 @@ static void fake_filter_ids(uint32_t *ids, unsigned *n)
         if ((fake.can.FA1R & (1UL << b)) == 0U) {
             continue;
         }
-        ck_assert_uint_ne(fake.can.FM1R & (1UL << b), 0U); /* list mode */
-        ck_assert_uint_eq(fake.can.FS1R & (1UL << b), 0U); /* 16-bit */
+        ck_assert_uint_ne(fake.can.FM1R & (1UL << b), 0U);  /* list mode */
+        ck_assert_uint_eq(fake.can.FS1R & (1UL << b), 0U);  /* 16-bit */
         ck_assert_uint_eq(fake.can.FFA1R & (1UL << b), 0U); /* FIFO 0 */
         const uint32_t words[2] = {fake.can.filter[b].FR1, fake.can.filter[b].FR2};
         for (unsigned w = 0; w < 2; ++w) {
@@ -414,16 +411,14 @@ static odo_params_t clapper_params(void)
     static sim_robot_t r;
     char err[256];
     odo_params_t p;
-    ck_assert_msg(sim_robot_parse_file(ODO_SOURCE_DIR "/host_sim/robots/clapper.json", &r, err, sizeof err) == 0, "%s", err);
+    ck_assert_msg(sim_robot_parse_file(ODO_SOURCE_DIR "/host_sim/robots/clapper.json", &r, err, sizeof err) == 0, "%s",
+                  err);
     ck_assert_msg(sim_robot_to_params(&r, &p, err, sizeof err) == 0, "%s", err);
     p.ipec_mode = (uint8_t)ODO_IPEC_PAPER;
     return p;
 }
 
-static void push(const odo_can_frame_t *f)
-{
-    fake_stm32_can_rx(f->id, false, false, f->dlc, f->data);
-}
+static void push(const odo_can_frame_t *f) { fake_stm32_can_rx(f->id, false, false, f->dlc, f->data); }
 
 /// The sensor frames of tick k: both trucks straight ahead, the link straight and at length.
 static void sensor_frames(uint32_t k, uint32_t link_um)
@@ -446,10 +441,10 @@ static void sensor_frames(uint32_t k, uint32_t link_um)
 /// One board over N ticks, with or without bad frames mixed in; returns the final output.
 typedef struct {
     odo_tick_output_t last;
-    uint32_t          faults_or;
-    uint16_t          rejected;
+    uint32_t faults_or;
+    uint16_t rejected;
     odo_board_rx_counts_t counts;
-    uint32_t          frames_sent;
+    uint32_t frames_sent;
 } board_run_t;
 
 static board_run_t run_board(bool with_bad_frames, uint32_t ticks)
@@ -473,11 +468,11 @@ static board_run_t run_board(bool with_bad_frames, uint32_t ticks)
             const odo_msg_wheel_counts_t w = {0x123456U, 0x654321U, (uint8_t)k, 0U};
             odo_can_pack_wheel_counts(ODO_TRUCK_A, &w, &f);
             fake_stm32_can_rx(f.id, false, false, 7U, f.data);
-            fake_stm32_can_rx(f.id, false, false, 15U, f.data);          /* DLC 15: 8 bytes, not 8 */
-            fake_stm32_can_rx(0x7FFU, false, false, 8U, f.data);         /* an identifier we don't know */
+            fake_stm32_can_rx(f.id, false, false, 15U, f.data);                    /* DLC 15: 8 bytes, not 8 */
+            fake_stm32_can_rx(0x7FFU, false, false, 8U, f.data);                   /* an identifier we don't know */
             fake_stm32_can_rx(ODO_CAN_ID_WHEEL_COUNTS_A, true, false, 8U, f.data); /* extended 0x110 */
             fake_stm32_can_rx(ODO_CAN_ID_LINK_ROTARY, false, true, 6U, f.data);    /* remote request */
-            odo_can_pack_pose_xy(ODO_TRUCK_A, &(odo_msg_pose_xy_t){1, 2}, &f);      /* someone's output */
+            odo_can_pack_pose_xy(ODO_TRUCK_A, &(odo_msg_pose_xy_t){1, 2}, &f);     /* someone's output */
             push(&f);
         }
         sensor_frames(k, link_um);
@@ -513,8 +508,9 @@ START_TEST(bad_frames_are_counted_and_never_integrated)
         ck_assert_uint_eq(dirty.last.pose[t].heading_q64, clean.last.pose[t].heading_q64);
     }
     ck_assert_int_gt(clean.last.pose[0].x_mm_q32, 0); /* it did drive */
-    ck_assert_uint_eq(clean.faults_or & (ODO_FAULT_CAN_BAD_DLC | ODO_FAULT_CAN_UNKNOWN_ID |
-                                         ODO_FAULT_COUNTER_JUMP_A | ODO_FAULT_IPEC_GATED), 0U);
+    ck_assert_uint_eq(clean.faults_or & (ODO_FAULT_CAN_BAD_DLC | ODO_FAULT_CAN_UNKNOWN_ID | ODO_FAULT_COUNTER_JUMP_A |
+                                         ODO_FAULT_IPEC_GATED),
+                      0U);
     ck_assert_uint_eq(dirty.faults_or & ODO_FAULT_COUNTER_JUMP_A, 0U);
     const uint32_t bursts = 10U; /* ticks 2, 7, ... 47 */
     ck_assert_uint_eq(dirty.counts.bad_dlc, 2U * bursts);

@@ -190,7 +190,7 @@ static void step_is_deterministic_for_identical_inputs(void)
  * Faults at speed and silent limits (issue 16): each of these failed on the code before it.
  * ------------------------------------------------------------------------------------------- */
 
-#define K_MM (3.14159265358979323846 * 150.0 / 39000.0) /* the default labmate: mm per count */
+#define K_MM         (3.14159265358979323846 * 150.0 / 39000.0) /* the default labmate: mm per count */
 #define MM_OF_Q32(v) ((double)(v) / 4294967296.0)
 
 static void boot_defaults(uint8_t counter_bits)
@@ -355,7 +355,7 @@ static void a_pose_beyond_the_integrable_range_is_held_and_flagged(void)
 
     /* just inside the limit a step still integrates; the tick that crosses it raises the flag */
     app.truck[0].pose.x_mm_q32 = ODO_POSE_LIMIT_MM_Q32 - ((int64_t)50 << 32); /* 50 mm short */
-    in = tick(80000U, 16000U, 16000U, 2U); /* 96.7 mm */
+    in = tick(80000U, 16000U, 16000U, 2U);                                    /* 96.7 mm */
     odo_app_step(&app, &in, &out);
     TEST_ASSERT_TRUE(app.truck[0].pose.x_mm_q32 > ODO_POSE_LIMIT_MM_Q32);
     TEST_ASSERT_NOT_EQUAL(0U, out.faults & ODO_FAULT_POSE_RANGE);
@@ -438,7 +438,7 @@ static void unused_truck_record_does_not_stop_a_single_truck_from_booting(void)
     odo_params_t p;
     odo_params_defaults(&p);
     p.counter_bits = 12U;
-    p.tick_us = 50000U;                          /* OptiOdom: D 84 mm, 2796.8 counts/turn */
+    p.tick_us = 50000U; /* OptiOdom: D 84 mm, 2796.8 counts/turn */
     p.truck[0].wheel_diameter_nm = 84000000U;
     p.truck[0].counts_per_rev_milli = 2796800U;
     p.truck[0].wheelbase_nm = 200000000U;

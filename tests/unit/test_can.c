@@ -19,19 +19,18 @@ void tearDown(void) {}
 
 typedef union {
     odo_msg_wheel_counts_t wheel;
-    odo_msg_link_rotary_t  rotary;
-    odo_msg_link_linear_t  linear;
-    odo_msg_pose_xy_t      xy;
-    odo_msg_pose_theta_t   theta;
-    odo_msg_ipec_corr_t    ipec;
-    odo_msg_status_t       status;
+    odo_msg_link_rotary_t rotary;
+    odo_msg_link_linear_t linear;
+    odo_msg_pose_xy_t xy;
+    odo_msg_pose_theta_t theta;
+    odo_msg_ipec_corr_t ipec;
+    odo_msg_status_t status;
 } any_msg_t;
 
 static const odo_can_msg_t all_msgs[ODO_CAN_MSG_COUNT] = {
-    ODO_CAN_MSG_WHEEL_COUNTS_A, ODO_CAN_MSG_WHEEL_COUNTS_B, ODO_CAN_MSG_LINK_ROTARY,
-    ODO_CAN_MSG_LINK_LINEAR,    ODO_CAN_MSG_POSE_XY_A,      ODO_CAN_MSG_POSE_THETA_A,
-    ODO_CAN_MSG_POSE_XY_B,      ODO_CAN_MSG_POSE_THETA_B,   ODO_CAN_MSG_IPEC_CORR,
-    ODO_CAN_MSG_STATUS,
+    ODO_CAN_MSG_WHEEL_COUNTS_A, ODO_CAN_MSG_WHEEL_COUNTS_B, ODO_CAN_MSG_LINK_ROTARY, ODO_CAN_MSG_LINK_LINEAR,
+    ODO_CAN_MSG_POSE_XY_A,      ODO_CAN_MSG_POSE_THETA_A,   ODO_CAN_MSG_POSE_XY_B,   ODO_CAN_MSG_POSE_THETA_B,
+    ODO_CAN_MSG_IPEC_CORR,      ODO_CAN_MSG_STATUS,
 };
 
 static uint32_t rnd32(void) { return (uint32_t)ts_rng_u64(&rng); }
@@ -44,21 +43,21 @@ static void random_msg(odo_can_msg_t m, any_msg_t *a)
     switch (m) {
     case ODO_CAN_MSG_WHEEL_COUNTS_A:
     case ODO_CAN_MSG_WHEEL_COUNTS_B:
-        a->wheel.left_count  = rnd32() & ODO_CAN_COUNT_MASK;
+        a->wheel.left_count = rnd32() & ODO_CAN_COUNT_MASK;
         a->wheel.right_count = rnd32() & ODO_CAN_COUNT_MASK;
-        a->wheel.seq         = rnd8();
-        a->wheel.status      = rnd8();
+        a->wheel.seq = rnd8();
+        a->wheel.status = rnd8();
         break;
     case ODO_CAN_MSG_LINK_ROTARY:
         a->rotary.alpha_bam16 = (uint16_t)rnd32();
-        a->rotary.beta_bam16  = (uint16_t)rnd32();
-        a->rotary.seq         = rnd8();
-        a->rotary.status      = rnd8();
+        a->rotary.beta_bam16 = (uint16_t)rnd32();
+        a->rotary.seq = rnd8();
+        a->rotary.status = rnd8();
         break;
     case ODO_CAN_MSG_LINK_LINEAR:
         a->linear.length_um = rnd32();
-        a->linear.seq       = rnd8();
-        a->linear.status    = rnd8();
+        a->linear.seq = rnd8();
+        a->linear.status = rnd8();
         break;
     case ODO_CAN_MSG_POSE_XY_A:
     case ODO_CAN_MSG_POSE_XY_B:
@@ -68,30 +67,27 @@ static void random_msg(odo_can_msg_t m, any_msg_t *a)
     case ODO_CAN_MSG_POSE_THETA_A:
     case ODO_CAN_MSG_POSE_THETA_B:
         a->theta.theta_bam = rnd32();
-        a->theta.seq       = rnd8();
-        a->theta.flags     = rnd8();
+        a->theta.seq = rnd8();
+        a->theta.flags = rnd8();
         break;
     case ODO_CAN_MSG_IPEC_CORR:
         a->ipec.dtheta_a_bam = (int32_t)ts_rng_range(&rng, INT32_MIN, INT32_MAX);
         a->ipec.dtheta_b_bam = (int32_t)ts_rng_range(&rng, INT32_MIN, INT32_MAX);
         break;
     case ODO_CAN_MSG_STATUS:
-        a->status.faults      = rnd32();
-        a->status.seq         = rnd8();
+        a->status.faults = rnd32();
+        a->status.seq = rnd8();
         a->status.param_state = rnd8();
-        a->status.rejected    = (uint16_t)rnd32();
+        a->status.rejected = (uint16_t)rnd32();
         break;
     case ODO_CAN_MSG_UNKNOWN:
-    default:
-        TEST_FAIL_MESSAGE("no such message");
-        break;
+    default: TEST_FAIL_MESSAGE("no such message"); break;
     }
 }
 
 static uint8_t truck_of(odo_can_msg_t m)
 {
-    return (m == ODO_CAN_MSG_WHEEL_COUNTS_B || m == ODO_CAN_MSG_POSE_XY_B ||
-            m == ODO_CAN_MSG_POSE_THETA_B)
+    return (m == ODO_CAN_MSG_WHEEL_COUNTS_B || m == ODO_CAN_MSG_POSE_XY_B || m == ODO_CAN_MSG_POSE_THETA_B)
                ? ODO_TRUCK_B
                : ODO_TRUCK_A;
 }
@@ -134,8 +130,7 @@ static void pack_any(odo_can_msg_t m, const any_msg_t *a, odo_can_frame_t *f)
 }
 
 /* The unpacker responsible for message m (the A/B pair share one). */
-static odo_can_result_t unpack_any(odo_can_msg_t m, const odo_can_frame_t *f, uint8_t *truck,
-                                   any_msg_t *a)
+static odo_can_result_t unpack_any(odo_can_msg_t m, const odo_can_frame_t *f, uint8_t *truck, any_msg_t *a)
 {
     switch (m) {
     case ODO_CAN_MSG_WHEEL_COUNTS_A:
@@ -174,9 +169,8 @@ static void check_round_trip(odo_can_msg_t m, const any_msg_t *in)
     uint8_t truck = 0xEEU;
     TEST_ASSERT_EQUAL_INT(ODO_CAN_OK, unpack_any(m, &f, &truck, &out));
     TEST_ASSERT_EQUAL_MEMORY(in, &out, sizeof out);
-    if (m == ODO_CAN_MSG_WHEEL_COUNTS_A || m == ODO_CAN_MSG_WHEEL_COUNTS_B ||
-        m == ODO_CAN_MSG_POSE_XY_A || m == ODO_CAN_MSG_POSE_XY_B ||
-        m == ODO_CAN_MSG_POSE_THETA_A || m == ODO_CAN_MSG_POSE_THETA_B) {
+    if (m == ODO_CAN_MSG_WHEEL_COUNTS_A || m == ODO_CAN_MSG_WHEEL_COUNTS_B || m == ODO_CAN_MSG_POSE_XY_A ||
+        m == ODO_CAN_MSG_POSE_XY_B || m == ODO_CAN_MSG_POSE_THETA_A || m == ODO_CAN_MSG_POSE_THETA_B) {
         TEST_ASSERT_EQUAL_UINT8(truck_of(m), truck);
     } else {
         TEST_ASSERT_EQUAL_HEX8_MESSAGE(0xEEU, truck, "single-truck unpacker wrote a truck index");
@@ -196,13 +190,13 @@ static void check_random_round_trips(odo_can_msg_t m)
 static void extreme_msg(odo_can_msg_t m, int which, any_msg_t *a)
 {
     const uint32_t u32 = which == 0 ? 0U : UINT32_MAX;
-    const uint8_t  u8  = which == 0 ? 0U : UINT8_MAX;
-    const int32_t  s32 = which == 0 ? INT32_MIN : which == 1 ? INT32_MAX : -1;
+    const uint8_t u8 = which == 0 ? 0U : UINT8_MAX;
+    const int32_t s32 = which == 0 ? INT32_MIN : which == 1 ? INT32_MAX : -1;
     memset(a, 0, sizeof *a);
     switch (m) {
     case ODO_CAN_MSG_WHEEL_COUNTS_A:
     case ODO_CAN_MSG_WHEEL_COUNTS_B:
-        a->wheel.left_count  = u32 & ODO_CAN_COUNT_MASK;
+        a->wheel.left_count = u32 & ODO_CAN_COUNT_MASK;
         a->wheel.right_count = u32 & ODO_CAN_COUNT_MASK;
         a->wheel.seq = a->wheel.status = u8;
         break;
@@ -223,8 +217,8 @@ static void extreme_msg(odo_can_msg_t m, int which, any_msg_t *a)
         break;
     case ODO_CAN_MSG_IPEC_CORR: a->ipec.dtheta_a_bam = a->ipec.dtheta_b_bam = s32; break;
     case ODO_CAN_MSG_STATUS:
-        a->status.faults   = u32;
-        a->status.seq      = a->status.param_state = u8;
+        a->status.faults = u32;
+        a->status.seq = a->status.param_state = u8;
         a->status.rejected = (uint16_t)u32;
         break;
     case ODO_CAN_MSG_UNKNOWN:
@@ -277,7 +271,7 @@ static void test_signed_signals_keep_int32_extremes_in_each_half(void)
 static void test_pose_xy_int32_min_is_little_endian_twos_complement(void)
 {
     odo_msg_pose_xy_t m = {INT32_MIN, 5};
-    odo_can_frame_t   f;
+    odo_can_frame_t f;
     odo_can_pack_pose_xy(ODO_TRUCK_A, &m, &f);
     const uint8_t want[8] = {0x00, 0x00, 0x00, 0x80, 0x05, 0x00, 0x00, 0x00};
     TEST_ASSERT_EQUAL_HEX32(0x180U, f.id);
@@ -287,7 +281,7 @@ static void test_pose_xy_int32_min_is_little_endian_twos_complement(void)
 static void test_wheel_counts_layout_matches_dbc_bytes(void)
 {
     odo_msg_wheel_counts_t m = {0x123456U, 0xABCDEFU, 0x42U, 0x0FU};
-    odo_can_frame_t        f;
+    odo_can_frame_t f;
     odo_can_pack_wheel_counts(ODO_TRUCK_B, &m, &f);
     const uint8_t want[8] = {0x56, 0x34, 0x12, 0xEF, 0xCD, 0xAB, 0x42, 0x0F};
     TEST_ASSERT_EQUAL_HEX32(0x111U, f.id);
@@ -319,7 +313,7 @@ static void test_six_byte_messages_layout_matches_dbc_bytes(void)
 static void test_status_layout_matches_dbc_bytes(void)
 {
     odo_msg_status_t m = {0x00020021UL, 0x10U, 5U, 0xBEEFU};
-    odo_can_frame_t  f;
+    odo_can_frame_t f;
     odo_can_pack_status(&m, &f);
     const uint8_t want[8] = {0x21, 0x00, 0x02, 0x00, 0x10, 0x05, 0xEF, 0xBE};
     TEST_ASSERT_EQUAL_HEX32(0x1A0U, f.id);
@@ -332,10 +326,10 @@ static void test_wheel_counts_send_only_the_low_24_bits(void)
 {
     for (int i = 0; i < N_RANDOM; i++) {
         odo_msg_wheel_counts_t m = {rnd32() | 0x01000000UL, rnd32(), rnd8(), rnd8()};
-        odo_can_frame_t        f;
+        odo_can_frame_t f;
         odo_can_pack_wheel_counts(ODO_TRUCK_A, &m, &f);
         odo_msg_wheel_counts_t out;
-        uint8_t                truck = 0xEEU;
+        uint8_t truck = 0xEEU;
         TEST_ASSERT_EQUAL_INT(ODO_CAN_OK, odo_can_unpack_wheel_counts(&f, &truck, &out));
         TEST_ASSERT_EQUAL_UINT8(ODO_TRUCK_A, truck);
         TEST_ASSERT_EQUAL_HEX32(m.left_count & ODO_CAN_COUNT_MASK, out.left_count);
@@ -346,7 +340,7 @@ static void test_wheel_counts_send_only_the_low_24_bits(void)
     }
     /* a 16-bit decoder's counter, zero-extended, wraps at 2^16 like the decoder does */
     odo_msg_wheel_counts_t m = {0xFFFFU, 0x0000U, 0U, 0U};
-    odo_can_frame_t        f;
+    odo_can_frame_t f;
     odo_can_pack_wheel_counts(ODO_TRUCK_A, &m, &f);
     const uint8_t want[8] = {0xFF, 0xFF, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00};
     TEST_ASSERT_EQUAL_HEX8_ARRAY(want, f.data, 8);
@@ -396,7 +390,7 @@ static void test_wrong_dlc_is_rejected_for_every_message_and_output_untouched(vo
 {
     for (unsigned i = 0; i < ODO_CAN_MSG_COUNT; i++) {
         odo_can_msg_t m = all_msgs[i];
-        any_msg_t     a;
+        any_msg_t a;
         random_msg(m, &a);
         odo_can_frame_t f;
         pack_any(m, &a, &f);
@@ -413,12 +407,12 @@ static void test_wrong_dlc_is_rejected_for_every_message_and_output_untouched(vo
 
 static void test_unknown_identifiers_are_rejected_by_every_unpacker(void)
 {
-    const uint32_t ids[] = {0x000U, 0x10FU, 0x112U, 0x122U, 0x184U, 0x191U, 0x1A1U, 0x7FFU,
-                            0x800U, 0x110U | 0x800U, 0x1FFFFFFFUL};
+    const uint32_t ids[] = {0x000U, 0x10FU, 0x112U, 0x122U,          0x184U,      0x191U,
+                            0x1A1U, 0x7FFU, 0x800U, 0x110U | 0x800U, 0x1FFFFFFFUL};
     for (unsigned k = 0; k < sizeof ids / sizeof ids[0]; k++) {
         odo_can_frame_t f;
         memset(&f, 0, sizeof f);
-        f.id  = ids[k];
+        f.id = ids[k];
         f.dlc = 8U;
         TEST_ASSERT_EQUAL_INT(ODO_CAN_MSG_UNKNOWN, odo_can_classify(&f));
         for (unsigned i = 0; i < ODO_CAN_MSG_COUNT; i++) {
@@ -444,8 +438,7 @@ static void test_each_unpacker_takes_only_its_own_identifiers(void)
 
 static void test_rtr_error_and_extended_frames_are_not_our_data_frames(void)
 {
-    const uint8_t flags[] = {ODO_CAN_FLAG_RTR, ODO_CAN_FLAG_ERR, ODO_CAN_FLAG_EXT,
-                             ODO_CAN_FLAG_EXT | ODO_CAN_FLAG_RTR};
+    const uint8_t flags[] = {ODO_CAN_FLAG_RTR, ODO_CAN_FLAG_ERR, ODO_CAN_FLAG_EXT, ODO_CAN_FLAG_EXT | ODO_CAN_FLAG_RTR};
     for (unsigned i = 0; i < ODO_CAN_MSG_COUNT; i++) {
         any_msg_t a;
         random_msg(all_msgs[i], &a);
@@ -453,7 +446,7 @@ static void test_rtr_error_and_extended_frames_are_not_our_data_frames(void)
         pack_any(all_msgs[i], &a, &f);
         for (unsigned k = 0; k < sizeof flags / sizeof flags[0]; k++) {
             odo_can_frame_t g = f;
-            g.flags           = flags[k];
+            g.flags = flags[k];
             TEST_ASSERT_EQUAL_INT(ODO_CAN_MSG_UNKNOWN, odo_can_classify(&g));
             expect_unpack(all_msgs[i], &g, ODO_CAN_ERR_FLAGS);
             /* flags are checked first: an RTR frame usually has no data and any DLC */
@@ -499,10 +492,9 @@ static void test_unpackers_ignore_garbage_beyond_the_dlc(void)
 static void test_layout_table_is_consistent(void)
 {
     const uint32_t ids[ODO_CAN_MSG_COUNT] = {
-        ODO_CAN_ID_WHEEL_COUNTS_A, ODO_CAN_ID_WHEEL_COUNTS_B, ODO_CAN_ID_LINK_ROTARY,
-        ODO_CAN_ID_LINK_LINEAR,    ODO_CAN_ID_POSE_XY_A,      ODO_CAN_ID_POSE_THETA_A,
-        ODO_CAN_ID_POSE_XY_B,      ODO_CAN_ID_POSE_THETA_B,   ODO_CAN_ID_IPEC_CORR,
-        ODO_CAN_ID_STATUS};
+        ODO_CAN_ID_WHEEL_COUNTS_A, ODO_CAN_ID_WHEEL_COUNTS_B, ODO_CAN_ID_LINK_ROTARY, ODO_CAN_ID_LINK_LINEAR,
+        ODO_CAN_ID_POSE_XY_A,      ODO_CAN_ID_POSE_THETA_A,   ODO_CAN_ID_POSE_XY_B,   ODO_CAN_ID_POSE_THETA_B,
+        ODO_CAN_ID_IPEC_CORR,      ODO_CAN_ID_STATUS};
     TEST_ASSERT_NULL(odo_can_msg_info(ODO_CAN_MSG_UNKNOWN));
     TEST_ASSERT_NULL(odo_can_msg_info((odo_can_msg_t)(ODO_CAN_MSG_COUNT + 1U)));
     TEST_ASSERT_EQUAL_UINT8(0U, odo_can_expected_dlc(ODO_CAN_MSG_UNKNOWN));
@@ -520,8 +512,7 @@ static void test_layout_table_is_consistent(void)
             const odo_can_signal_info_t *sig = &info->signals[s];
             TEST_ASSERT_NOT_NULL(sig->name);
             TEST_ASSERT_TRUE(sig->bit_len >= 1U && sig->bit_len <= 32U);
-            TEST_ASSERT_TRUE_MESSAGE(sig->start_bit + sig->bit_len <= 8U * info->dlc,
-                                     "signal beyond the DLC");
+            TEST_ASSERT_TRUE_MESSAGE(sig->start_bit + sig->bit_len <= 8U * info->dlc, "signal beyond the DLC");
             const uint64_t bits = ((UINT64_C(1) << sig->bit_len) - 1U) << sig->start_bit;
             TEST_ASSERT_EQUAL_HEX64_MESSAGE(0U, used & bits, "signals overlap");
             used |= bits;

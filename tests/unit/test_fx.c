@@ -169,10 +169,10 @@ static void muldiv_rounds_to_nearest_and_reports_overflow(void)
     TEST_ASSERT_TRUE(odo_muldiv_u64(UINT64_MAX, UINT64_MAX, UINT64_MAX, &q));
     TEST_ASSERT_EQUAL_UINT64(UINT64_MAX, q);
     q = 12345U;
-    TEST_ASSERT_FALSE(odo_muldiv_u64(1U, 1U, 0U, &q));          /* division by zero */
-    TEST_ASSERT_FALSE(odo_muldiv_u64(UINT64_MAX, 2U, 1U, &q));  /* quotient >= 2^64 */
-    TEST_ASSERT_FALSE(odo_muldiv_u64(UINT64_MAX, 3U, 2U, &q));  /* rounds up past 2^64 - 1 */
-    TEST_ASSERT_EQUAL_UINT64(12345U, q);                        /* untouched on failure */
+    TEST_ASSERT_FALSE(odo_muldiv_u64(1U, 1U, 0U, &q));         /* division by zero */
+    TEST_ASSERT_FALSE(odo_muldiv_u64(UINT64_MAX, 2U, 1U, &q)); /* quotient >= 2^64 */
+    TEST_ASSERT_FALSE(odo_muldiv_u64(UINT64_MAX, 3U, 2U, &q)); /* rounds up past 2^64 - 1 */
+    TEST_ASSERT_EQUAL_UINT64(12345U, q);                       /* untouched on failure */
     for (int n = 0; n < 100000; ++n) {
         const uint64_t a = spread_u64(), b = spread_u64(), d = spread_u64() | 1U;
         uint64_t rem = 0U;
@@ -196,9 +196,9 @@ static void mul_s64_s32_shr_is_exact_through_96_bits(void)
     /* Products far beyond 64 bits whose shifted result fits. */
     TEST_ASSERT_EQUAL_INT64(INT64_MAX, odo_mul_s64_s32_shr(INT64_MAX, 1 << 30, 30U));
     TEST_ASSERT_EQUAL_INT64(INT64_MIN, odo_mul_s64_s32_shr(INT64_MIN, 1 << 30, 30U));
-    TEST_ASSERT_EQUAL_INT64(-3, odo_mul_s64_s32_shr(-5, 1, 1U));  /* -2.5 rounds away from zero */
+    TEST_ASSERT_EQUAL_INT64(-3, odo_mul_s64_s32_shr(-5, 1, 1U)); /* -2.5 rounds away from zero */
     TEST_ASSERT_EQUAL_INT64(3, odo_mul_s64_s32_shr(5, 1, 1U));
-    TEST_ASSERT_EQUAL_INT64(-2, odo_mul_s64_s32_shr(-9, 1, 2U));  /* -2.25 -> -2 */
+    TEST_ASSERT_EQUAL_INT64(-2, odo_mul_s64_s32_shr(-9, 1, 2U)); /* -2.25 -> -2 */
     const int64_t ea[] = {INT64_MIN, INT64_MIN + 1, -1, 0, 1, INT64_MAX};
     const int32_t eb[] = {INT32_MIN, -1, 0, 1, INT32_MAX, 1 << 30};
     for (int n = 0; n < 300000; ++n) {
@@ -340,7 +340,7 @@ static void shifts_are_defined_for_every_shift_and_saturate(void)
     TEST_ASSERT_EQUAL_INT64(INT64_MAX, odo_mul_s64_s32_shr(INT64_MAX, 2, 0U));
     TEST_ASSERT_EQUAL_INT64(INT64_MIN, odo_mul_s64_s32_shr(INT64_MIN, 1, 0U));
     TEST_ASSERT_EQUAL_INT64(INT64_MAX, odo_mul_s64_s32_shr(INT64_MIN, -1, 0U)); /* 2^63 saturates */
-    TEST_ASSERT_EQUAL_INT64(1, odo_mul_s64_s32_shr(INT64_MIN, INT32_MIN, 95U));  /* exactly 1/2 */
+    TEST_ASSERT_EQUAL_INT64(1, odo_mul_s64_s32_shr(INT64_MIN, INT32_MIN, 95U)); /* exactly 1/2 */
     TEST_ASSERT_EQUAL_INT64(0, odo_mul_s64_s32_shr(INT64_MIN, INT32_MIN, 96U));
     TEST_ASSERT_EQUAL_INT64(0, odo_mul_s64_s32_shr(INT64_MAX, INT32_MAX, 200U));
     TEST_ASSERT_EQUAL_INT64(INT64_MAX, odo_mul_s64_u32_shr(INT64_MAX, UINT32_MAX, 0U));
@@ -353,8 +353,8 @@ static void shifts_are_defined_for_every_shift_and_saturate(void)
     TEST_ASSERT_EQUAL_INT64(0, odo_shr_round_s64(INT64_MAX, 64U));
     TEST_ASSERT_EQUAL_INT64(0, odo_shr_round_s64(INT64_MIN, 65U));
     TEST_ASSERT_EQUAL_INT64(0, odo_shr_round_s64(INT64_MIN, UINT32_MAX));
-    const int64_t ea[] = {0, 1, -1, 3, -3, INT64_MAX, INT64_MIN, INT64_MAX - 1, INT64_MIN + 1,
-                          (int64_t)1 << 62, -((int64_t)1 << 62)};
+    const int64_t ea[] = {
+        0, 1, -1, 3, -3, INT64_MAX, INT64_MIN, INT64_MAX - 1, INT64_MIN + 1, (int64_t)1 << 62, -((int64_t)1 << 62)};
     const int32_t eb[] = {0, 1, -1, 2, -2, INT32_MAX, INT32_MIN, 1 << 30, -(1 << 30)};
     for (unsigned shift = 0U; shift < 128U; ++shift) {
         for (unsigned i = 0U; i < sizeof ea / sizeof ea[0]; ++i) {

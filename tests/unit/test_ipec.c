@@ -12,7 +12,7 @@
 void setUp(void) {}
 void tearDown(void) {}
 
-#define Q32 4294967296.0
+#define Q32         4294967296.0
 #define BAM_PER_DEG (4294967296.0 / 360.0)
 
 static odo_pose_t pose_at(double x_mm, double y_mm, double theta_deg)
@@ -47,8 +47,8 @@ static void eq10_from_b_to_a_makes_eq16_put_b_l_behind_a(void)
         const odo_pose_t a = pose_at(cases[i][0], cases[i][1], cases[i][2]);
         const odo_pose_t b = pose_at(cases[i][0] - 1000.0 * cos(th), cases[i][1] - 1000.0 * sin(th), 0);
         const uint32_t tl = odo_ipec_link_heading_bam(&a, &b);
-        TEST_ASSERT_FLOAT_WITHIN(1e-5, cases[i][2], deg_of(tl - (uint32_t)llround(0.0)) -
-                                                        (cases[i][2] > 180.0 ? 360.0 : 0.0));
+        TEST_ASSERT_FLOAT_WITHIN(1e-5, cases[i][2],
+                                 deg_of(tl - (uint32_t)llround(0.0)) - (cases[i][2] > 180.0 ? 360.0 : 0.0));
         odo_pose_t b2 = a;
         odo_ipec_anchor(&a, tl, odo_ipec_nm_to_mm_q32(1000000000LL), &b2);
         TEST_ASSERT_FLOAT_WITHIN(1e-4, mm(b.x_mm_q32), mm(b2.x_mm_q32));

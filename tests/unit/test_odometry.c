@@ -11,8 +11,8 @@
 void setUp(void) {}
 void tearDown(void) {}
 
-#define Q30(x) ((int32_t)llround((x) * 1073741824.0))
-#define MM_Q32(v) ((double)(v) / 4294967296.0)
+#define Q30(x)              ((int32_t)llround((x)*1073741824.0))
+#define MM_Q32(v)           ((double)(v) / 4294967296.0)
 #define TURNS_Q64_TO_RAD(v) ((double)(int64_t)(v) / 18446744073709551616.0 * 2.0 * M_PI)
 
 static odo_truck_params_t labmate(void)
@@ -43,8 +43,7 @@ static odo_truck_t truck_at_origin(const odo_model_t *m, uint32_t left, uint32_t
 
 static double cm_mm(const odo_truck_params_t *tp)
 {
-    return M_PI * (tp->wheel_diameter_nm * 1e-6 / (tp->es_q30 / 1073741824.0)) /
-           (tp->counts_per_rev_milli * 1e-3);
+    return M_PI * (tp->wheel_diameter_nm * 1e-6 / (tp->es_q30 / 1073741824.0)) / (tp->counts_per_rev_milli * 1e-3);
 }
 
 static void multipliers_follow_eqs_2_1_6_33_6_34_and_6_28(void)
@@ -60,12 +59,12 @@ static void multipliers_follow_eqs_2_1_6_33_6_34_and_6_28(void)
     const double b_eff = eb * 340.0;
     /* within half an LSB of the Q40 format (plus the reference's own rounding) */
     const double half_lsb = 0.5 / 1099511627776.0 + 1e-15;
-    TEST_ASSERT_DOUBLE_WITHIN(half_lsb, kl, m.dist_mm_q40[0] / 1099511627776.0);
-    TEST_ASSERT_DOUBLE_WITHIN(half_lsb, kr, m.dist_mm_q40[1] / 1099511627776.0);
+    TEST_ASSERT_DOUBLE_WITHIN(half_lsb, kl, (double)m.dist_mm_q40[0] / 1099511627776.0);
+    TEST_ASSERT_DOUBLE_WITHIN(half_lsb, kr, (double)m.dist_mm_q40[1] / 1099511627776.0);
     TEST_ASSERT_DOUBLE_WITHIN(1e-9, ed, (double)m.dist_mm_q40[1] / (double)m.dist_mm_q40[0]);
     const double tl = kl / (2.0 * M_PI * b_eff), tr = kr / (2.0 * M_PI * b_eff);
-    TEST_ASSERT_DOUBLE_WITHIN(1e-12 * tl, tl, m.turn_q64[0] / 18446744073709551616.0);
-    TEST_ASSERT_DOUBLE_WITHIN(1e-12 * tr, tr, m.turn_q64[1] / 18446744073709551616.0);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-12 * tl, tl, (double)m.turn_q64[0] / 18446744073709551616.0);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-12 * tr, tr, (double)m.turn_q64[1] / 18446744073709551616.0);
     /* max counts: 3 m/s for 40 ms over the smaller k, plus one */
     TEST_ASSERT_UINT32_WITHIN(1U, (uint32_t)ceil(120.0 / kl) + 1U, m.max_counts);
 }
@@ -91,8 +90,8 @@ static void count_delta_handles_every_wrap_of_16_24_32_bit_counters(void)
         const int64_t half = (int64_t)1 << (bits - 1U);
         const int64_t start = ts_rng_range(&rng, 0, 2 * half - 1);
         const int64_t delta = ts_rng_range(&rng, -half, half - 1);
-        TEST_ASSERT_EQUAL_INT32((int32_t)delta, odo_count_delta(ts_wrap_counter(start, bits),
-                                                                ts_wrap_counter(start + delta, bits), bits));
+        TEST_ASSERT_EQUAL_INT32(
+            (int32_t)delta, odo_count_delta(ts_wrap_counter(start, bits), ts_wrap_counter(start + delta, bits), bits));
     }
 }
 
@@ -365,7 +364,7 @@ static void spot_turn_is_unchanged_by_scrub(void)
     int32_t d[300][2];
     for (int i = 0; i < 300; ++i) {
         const int32_t n = 1 + (i * 37) % 600;
-        d[i][0] = (i % 3 == 2) ? 0 : ((i & 1) ? -n : n);     /* spot turns both ways, pivots */
+        d[i][0] = (i % 3 == 2) ? 0 : ((i & 1) ? -n : n); /* spot turns both ways, pivots */
         d[i][1] = (i % 3 == 2) ? n : -d[i][0];
     }
     for (size_t k = 0; k < sizeof ks_q30 / sizeof ks_q30[0]; ++k) {
@@ -397,13 +396,12 @@ static void arc_of_known_radius_gets_the_predicted_factor(void)
         int32_t dl, dr;
         double k;
     } arcs[] = {
-        {1000, 1459, 0.0095},  /* R ~ 0.43 m at b 340 mm, OptiOdom's k */
-        {1459, 1000, 0.0095},  /* the other side */
-        {-1000, -1459, 0.0095}, /* backwards */
-        {700, 2100, 0.2},      /* tight: s = 0.5 */
-        {2100, 700, -0.2},
-        {1500, 1501, -0.25},   /* almost straight: s ~ 3e-4 */
-        {1, 600, 0.25},        /* almost a pivot */
+        {1000, 1459, 0.0095},                        /* R ~ 0.43 m at b 340 mm, OptiOdom's k */
+        {1459, 1000, 0.0095},                        /* the other side */
+        {-1000, -1459, 0.0095},                      /* backwards */
+        {700, 2100, 0.2},                            /* tight: s = 0.5 */
+        {2100, 700, -0.2},      {1500, 1501, -0.25}, /* almost straight: s ~ 3e-4 */
+        {1, 600, 0.25},                              /* almost a pivot */
     };
     for (size_t i = 0; i < sizeof arcs / sizeof arcs[0]; ++i) {
         odo_truck_params_t tp = labmate(), tk = labmate();
@@ -479,7 +477,7 @@ static void scrub_factor_error_is_below_2e_minus_32_on_random_ticks(void)
     ts_rng_t rng;
     ts_rng_seed(&rng, 0xFAC7ULL);
     odo_truck_params_t tp = labmate(), tk = labmate();
-    tk.scrub_q30 = -(int32_t)(1 << 28); /* the largest |k| */
+    tk.scrub_q30 = -(int32_t)(1 << 28);                              /* the largest |k| */
     tp.counts_per_rev_milli = tk.counts_per_rev_milli = 4000000000U; /* big deltas: up to ~1e6 */
     const odo_model_t m0 = model_of(&tp, 32U, ODO_HEADING_MIDPOINT), mk = model_of(&tk, 32U, ODO_HEADING_MIDPOINT);
     double worst = 0.0;
@@ -531,8 +529,8 @@ static void count_delta_handles_8_and_12_bit_counters(void)
         const int64_t half = (int64_t)1 << (bits - 1U);
         const int64_t start = ts_rng_range(&rng, 0, 2 * half - 1);
         const int64_t delta = ts_rng_range(&rng, -half, half - 1);
-        TEST_ASSERT_EQUAL_INT32((int32_t)delta, odo_count_delta(ts_wrap_counter(start, bits),
-                                                                ts_wrap_counter(start + delta, bits), bits));
+        TEST_ASSERT_EQUAL_INT32(
+            (int32_t)delta, odo_count_delta(ts_wrap_counter(start, bits), ts_wrap_counter(start + delta, bits), bits));
     }
 }
 

@@ -94,20 +94,20 @@ typedef enum { K_U8, K_U16, K_U32, K_I32 } kind_t;
 typedef struct {
     const char *name;
     odo_param_field_t field;
-    bool in_truck;  ///< offset is into odo_truck_params_t rather than odo_params_t
+    bool in_truck; ///< offset is into odo_truck_params_t rather than odo_params_t
     size_t offset;
     kind_t kind;
     int64_t lo, hi;
 } range_case_t;
 
-#define NM_PER_MM 1000000LL
-#define NM_PER_M  1000000000LL
-#define Q30_0_8   ((((int64_t)4) << 30) / 5) /* 0.8 * 2^30 = 858993459.2, truncated */
-#define Q30_1_25  ((((int64_t)5) << 30) / 4)
-#define Q30_0_25  (((int64_t)1) << 28)
+#define NM_PER_MM  1000000LL
+#define NM_PER_M   1000000000LL
+#define Q30_0_8    ((((int64_t)4) << 30) / 5) /* 0.8 * 2^30 = 858993459.2, truncated */
+#define Q30_1_25   ((((int64_t)5) << 30) / 4)
+#define Q30_0_25   (((int64_t)1) << 28)
 #define BAM_DEG(d) (((((int64_t)(d)) << 32) + 180) / 360) /* rounded to nearest */
 
-#define TR(f) true, offsetof(odo_truck_params_t, f)
+#define TR(f)  true, offsetof(odo_truck_params_t, f)
 #define TOP(f) false, offsetof(odo_params_t, f)
 
 static const range_case_t k_ranges[] = {
@@ -118,8 +118,7 @@ static const range_case_t k_ranges[] = {
     {"tick_us", ODO_PF_TICK_US, TOP(tick_us), K_U32, 1000, 1000000},
     {"max_wheel_speed_mm_s", ODO_PF_MAX_WHEEL_SPEED, TOP(max_wheel_speed_mm_s), K_U32, 100, 20000},
     {"wheel_diameter_nm", ODO_PF_WHEEL_DIAMETER, TR(wheel_diameter_nm), K_U32, 10 * NM_PER_MM, 2 * NM_PER_M},
-    {"counts_per_rev_milli", ODO_PF_COUNTS_PER_REV, TR(counts_per_rev_milli), K_U32, 100 * 1000,
-     4000000LL * 1000},
+    {"counts_per_rev_milli", ODO_PF_COUNTS_PER_REV, TR(counts_per_rev_milli), K_U32, 100 * 1000, 4000000LL * 1000},
     {"wheelbase_nm", ODO_PF_WHEELBASE, TR(wheelbase_nm), K_U32, 50 * NM_PER_MM, 3 * NM_PER_M},
     {"ed_q30", ODO_PF_ED, TR(ed_q30), K_I32, Q30_0_8, Q30_1_25},
     {"eb_q30", ODO_PF_EB, TR(eb_q30), K_I32, Q30_0_8, Q30_1_25},
@@ -127,10 +126,8 @@ static const range_case_t k_ranges[] = {
     {"scrub_q30", ODO_PF_SCRUB, TR(scrub_q30), K_I32, -Q30_0_25, Q30_0_25},
     {"link.length_nm", ODO_PF_LINK_LENGTH, TOP(link.length_nm), K_U32, 100 * NM_PER_MM, 4 * NM_PER_M},
     {"link.hitch_offset_nm", ODO_PF_HITCH_OFFSET, TOP(link.hitch_offset_nm), K_U32, 0, 4 * NM_PER_M},
-    {"link.length_bias_nm", ODO_PF_LENGTH_BIAS, TOP(link.length_bias_nm), K_I32, -50 * NM_PER_MM,
-     50 * NM_PER_MM},
-    {"link.length_ecc_nm", ODO_PF_LENGTH_ECC, TOP(link.length_ecc_nm), K_I32, -50 * NM_PER_MM,
-     50 * NM_PER_MM},
+    {"link.length_bias_nm", ODO_PF_LENGTH_BIAS, TOP(link.length_bias_nm), K_I32, -50 * NM_PER_MM, 50 * NM_PER_MM},
+    {"link.length_ecc_nm", ODO_PF_LENGTH_ECC, TOP(link.length_ecc_nm), K_I32, -50 * NM_PER_MM, 50 * NM_PER_MM},
     {"link.alpha_bias_bam", ODO_PF_ALPHA_BIAS, TOP(link.alpha_bias_bam), K_I32, -BAM_DEG(10), BAM_DEG(10)},
     {"link.beta_bias_bam", ODO_PF_BETA_BIAS, TOP(link.beta_bias_bam), K_I32, -BAM_DEG(10), BAM_DEG(10)},
     {"link.rotary_bits", ODO_PF_ROTARY_BITS, TOP(link.rotary_bits), K_U8, 8, 16},
@@ -158,17 +155,33 @@ static void set_field(odo_params_t *p, const range_case_t *c, unsigned truck, in
     uint8_t *base = c->in_truck ? (uint8_t *)&p->truck[truck] : (uint8_t *)p;
     uint8_t *dst = base + c->offset;
     switch (c->kind) {
-    case K_U8: { uint8_t x = (uint8_t)v; memcpy(dst, &x, sizeof x); break; }
-    case K_U16: { uint16_t x = (uint16_t)v; memcpy(dst, &x, sizeof x); break; }
-    case K_U32: { uint32_t x = (uint32_t)v; memcpy(dst, &x, sizeof x); break; }
-    case K_I32: { int32_t x = (int32_t)v; memcpy(dst, &x, sizeof x); break; }
+    case K_U8: {
+        uint8_t x = (uint8_t)v;
+        memcpy(dst, &x, sizeof x);
+        break;
+    }
+    case K_U16: {
+        uint16_t x = (uint16_t)v;
+        memcpy(dst, &x, sizeof x);
+        break;
+    }
+    case K_U32: {
+        uint32_t x = (uint32_t)v;
+        memcpy(dst, &x, sizeof x);
+        break;
+    }
+    case K_I32: {
+        int32_t x = (int32_t)v;
+        memcpy(dst, &x, sizeof x);
+        break;
+    }
     }
 }
 
 /// Encode p (correct CRC), decode it, and check the status; on rejection also check that
 /// odo_params_validate names `field` in `truck` and that decode left *out alone.
-static void expect_block(const odo_params_t *p, odo_params_status_t want, odo_param_field_t field,
-                         uint8_t truck, const char *what)
+static void expect_block(const odo_params_t *p, odo_params_status_t want, odo_param_field_t field, uint8_t truck,
+                         const char *what)
 {
     uint8_t block[ODO_PARAMS_SIZE];
     odo_params_t out;
@@ -343,10 +356,10 @@ static void test_every_single_bit_flip_is_rejected_and_out_is_untouched(void)
             uint8_t b[ODO_PARAMS_SIZE];
             odo_params_t out;
             char msg[48];
-            odo_params_status_t want = i < 4 ? ODO_PARAMS_ERR_MAGIC
-                                     : i < 6 ? ODO_PARAMS_ERR_VERSION
-                                     : i < 8 ? ODO_PARAMS_ERR_LENGTH
-                                             : ODO_PARAMS_ERR_CRC;
+            odo_params_status_t want = i < 4   ? ODO_PARAMS_ERR_MAGIC
+                                       : i < 6 ? ODO_PARAMS_ERR_VERSION
+                                       : i < 8 ? ODO_PARAMS_ERR_LENGTH
+                                               : ODO_PARAMS_ERR_CRC;
             memcpy(b, good, sizeof b);
             b[i] ^= (uint8_t)(1U << bit);
             snprintf(msg, sizeof msg, "byte %u bit %u", i, bit);
@@ -514,11 +527,16 @@ static void test_length_limits_must_be_ordered_and_within_1mm_to_20m(void)
         uint32_t min_um, max_um;
         odo_param_field_t bad;
     } cases[] = {
-        {1000, 20000000, ODO_PF_NONE},        {999, 20000000, ODO_PF_LENGTH_MIN},
-        {1000, 20000001, ODO_PF_LENGTH_MAX},  {1000, 1001, ODO_PF_NONE},
-        {1000, 1000, ODO_PF_LENGTH_RANGE},    {1100000, 900000, ODO_PF_LENGTH_RANGE},
-        {19999999, 20000000, ODO_PF_NONE},    {20000000, 20000000, ODO_PF_LENGTH_RANGE},
-        {0, 1000, ODO_PF_LENGTH_MIN},         {999, 1000, ODO_PF_LENGTH_MIN},
+        {1000, 20000000, ODO_PF_NONE},
+        {999, 20000000, ODO_PF_LENGTH_MIN},
+        {1000, 20000001, ODO_PF_LENGTH_MAX},
+        {1000, 1001, ODO_PF_NONE},
+        {1000, 1000, ODO_PF_LENGTH_RANGE},
+        {1100000, 900000, ODO_PF_LENGTH_RANGE},
+        {19999999, 20000000, ODO_PF_NONE},
+        {20000000, 20000000, ODO_PF_LENGTH_RANGE},
+        {0, 1000, ODO_PF_LENGTH_MIN},
+        {999, 1000, ODO_PF_LENGTH_MIN},
         {20000001, 20000000, ODO_PF_LENGTH_MIN},
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
@@ -527,10 +545,8 @@ static void test_length_limits_must_be_ordered_and_within_1mm_to_20m(void)
         odo_params_defaults(&p);
         p.link.length_min_um = cases[i].min_um;
         p.link.length_max_um = cases[i].max_um;
-        snprintf(msg, sizeof msg, "min %lu max %lu", (unsigned long)cases[i].min_um,
-                 (unsigned long)cases[i].max_um);
-        expect_block(&p, cases[i].bad == ODO_PF_NONE ? ODO_PARAMS_OK : ODO_PARAMS_ERR_RANGE, cases[i].bad, 0,
-                     msg);
+        snprintf(msg, sizeof msg, "min %lu max %lu", (unsigned long)cases[i].min_um, (unsigned long)cases[i].max_um);
+        expect_block(&p, cases[i].bad == ODO_PF_NONE ? ODO_PARAMS_OK : ODO_PARAMS_ERR_RANGE, cases[i].bad, 0, msg);
     }
 }
 
@@ -567,8 +583,8 @@ static void test_validate_names_the_first_offending_field(void)
 /// version 2's tail 132..251), written out again here.
 static bool is_reserved_v2(unsigned i)
 {
-    return (i >= 20 + 25 && i <= 20 + 27) || (i >= 48 + 25 && i <= 48 + 27) || i == 101 ||
-           (i >= 120 && i <= 123) || (i >= 132 && i <= 251);
+    return (i >= 20 + 25 && i <= 20 + 27) || (i >= 48 + 25 && i <= 48 + 27) || i == 101 || (i >= 120 && i <= 123) ||
+           (i >= 132 && i <= 251);
 }
 
 /// Reserved bytes must be 0: a non-zero one means a writer that knows a layout this firmware does
@@ -624,7 +640,7 @@ static void test_load_falls_back_to_exactly_the_defaults_and_reports_why(void)
     }
     struct {
         const char *what;
-        unsigned off;   /* byte to change, or ~0 for none */
+        unsigned off; /* byte to change, or ~0 for none */
         uint8_t xor_;
         bool fix_crc;
         size_t len;
@@ -700,9 +716,9 @@ static void test_encode_into_too_small_a_buffer_returns_0_and_writes_nothing(voi
 
 static void test_every_status_has_distinct_text_and_crc_names_the_crc(void)
 {
-    static const odo_params_status_t all[] = {
-        ODO_PARAMS_OK,         ODO_PARAMS_ERR_SHORT, ODO_PARAMS_ERR_MAGIC, ODO_PARAMS_ERR_VERSION,
-        ODO_PARAMS_ERR_LENGTH, ODO_PARAMS_ERR_CRC,   ODO_PARAMS_ERR_RANGE, ODO_PARAMS_ERR_ARG};
+    static const odo_params_status_t all[] = {ODO_PARAMS_OK,          ODO_PARAMS_ERR_SHORT,  ODO_PARAMS_ERR_MAGIC,
+                                              ODO_PARAMS_ERR_VERSION, ODO_PARAMS_ERR_LENGTH, ODO_PARAMS_ERR_CRC,
+                                              ODO_PARAMS_ERR_RANGE,   ODO_PARAMS_ERR_ARG};
     const size_t n = sizeof all / sizeof all[0];
     for (size_t i = 0; i < n; i++) {
         TEST_ASSERT_NOT_NULL(odo_params_status_str(all[i]));
@@ -868,7 +884,7 @@ static void field_table_is_a_partition_of_the_block(void)
 {
     uint8_t owner[ODO_PARAMS_SIZE];
     memset(owner, 0, sizeof owner);
-    memset(owner, 0xFF, 8);                          /* header */
+    memset(owner, 0xFF, 8);                         /* header */
     memset(&owner[ODO_PARAMS_CRC_OFFSET], 0xFF, 4); /* CRC */
     const size_t n = odo_params_field_count();
     TEST_ASSERT_TRUE(n > 20 && n < 0xFF);
@@ -937,7 +953,7 @@ static void encoder_puts_every_field_at_its_table_offset(void)
         for (uint8_t t = 0; t < (f->scope == ODO_PSCOPE_TRUCK ? ODO_TRUCKS : 1U); t++) {
             uint32_t raw = 0;
             for (unsigned k = f->width; k > 0; k--) {
-                raw = (raw << 8) | b[f->offset + t * f->stride + k - 1];
+                raw = (raw << 8) | b[f->offset + (size_t)t * f->stride + k - 1U];
             }
             const int64_t want = odo_params_get(&p, (odo_param_field_t)f->id, t);
             const int64_t got = f->type == ODO_PTYPE_I32 ? (int64_t)(int32_t)raw : (int64_t)raw;
@@ -949,8 +965,8 @@ static void encoder_puts_every_field_at_its_table_offset(void)
 /// The scrub term's range, both trucks: |k| <= 0.25 in Q30 (the header), as a decoded block shows.
 static void scrub_outside_a_quarter_is_refused_naming_the_truck(void)
 {
-    static const int64_t cases[][2] = {{Q30_0_25, 1}, {-Q30_0_25, 1}, {Q30_0_25 + 1, 0}, {-Q30_0_25 - 1, 0},
-                                       {INT32_MAX, 0}, {INT32_MIN, 0}, {0, 1}};
+    static const int64_t cases[][2] = {
+        {Q30_0_25, 1}, {-Q30_0_25, 1}, {Q30_0_25 + 1, 0}, {-Q30_0_25 - 1, 0}, {INT32_MAX, 0}, {INT32_MIN, 0}, {0, 1}};
     for (uint8_t t = 0; t < ODO_TRUCKS; t++) {
         for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
             odo_params_t p;

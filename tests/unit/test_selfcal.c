@@ -10,13 +10,13 @@
 void setUp(void) {}
 void tearDown(void) {}
 
-#define TWO30 1073741824.0
+#define TWO30       1073741824.0
 #define BAM_PER_RAD (4294967296.0 / (2.0 * M_PI))
 
 typedef struct {
-    double ed_t, eb_t;  ///< the truth
-    double ed_f, eb_f;  ///< what the firmware uses
-    double b_mm;        ///< nominal wheelbase
+    double ed_t, eb_t; ///< the truth
+    double ed_f, eb_f; ///< what the firmware uses
+    double b_mm;       ///< nominal wheelbase
 } truck_t;
 
 /// Wheel factors of 000 Eq. 2.7 solved for the wheels (mean scale 1): cL = 2/(Ed+1), cR = Ed cL.

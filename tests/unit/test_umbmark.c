@@ -12,7 +12,7 @@
 void setUp(void) {}
 void tearDown(void) {}
 
-#define Q30 1073741824.0
+#define Q30     1073741824.0
 #define BAM_DEG (180.0 / 2147483648.0)
 
 static double q30(int32_t v) { return (double)v / Q30; }
@@ -100,7 +100,7 @@ static void centres_of_gravity_and_emax_follow_eqs_3_2_to_3_4(void)
 static void paper_model_round_trip_recovers_ed_and_eb_of_the_set_robot(void)
 {
     const double l = 4000.0, b_nom = 340.0, b_act = 337.0, ed = 0.9985;
-    const double alpha = (M_PI / 2.0) * (1.0 - b_nom / b_act);        /* Eq. 6.28 read backwards */
+    const double alpha = (M_PI / 2.0) * (1.0 - b_nom / b_act);       /* Eq. 6.28 read backwards */
     const double beta = 2.0 * l * (ed - 1.0) / ((ed + 1.0) * b_act); /* arc of a leg, Eq. 6.24 */
     double cg[2][2];
     paper_forward(l, alpha, beta, cg);
@@ -111,8 +111,8 @@ static void paper_model_round_trip_recovers_ed_and_eb_of_the_set_robot(void)
     odo_umb_stats_t s;
     TEST_ASSERT_EQUAL(ODO_UMB_OK, odo_umb_stats(cw, 2, ccw, 2, &s));
     odo_umb_calib_t c;
-    TEST_ASSERT_EQUAL(ODO_UMB_OK, odo_umb_calibrate(&s, 4000000U, 340000000U, ODO_RATIO_Q30_ONE,
-                                                    ODO_RATIO_Q30_ONE, &c));
+    TEST_ASSERT_EQUAL(ODO_UMB_OK,
+                      odo_umb_calibrate(&s, 4000000U, 340000000U, ODO_RATIO_Q30_ONE, ODO_RATIO_Q30_ONE, &c));
     TEST_ASSERT_DOUBLE_WITHIN(1e-4, alpha * 180.0 / M_PI, c.alpha_bam * BAM_DEG);
     TEST_ASSERT_DOUBLE_WITHIN(1e-4, beta * 180.0 / M_PI, c.beta_bam * BAM_DEG);
     /* The forward model is exactly consistent in x and y: the two forms agree to rounding. */
@@ -121,10 +121,10 @@ static void paper_model_round_trip_recovers_ed_and_eb_of_the_set_robot(void)
     TEST_ASSERT_DOUBLE_WITHIN(2e-6, ed, q30(c.ed_q30));
     TEST_ASSERT_DOUBLE_WITHIN(2e-6, b_act / b_nom, q30(c.eb_q30));
     TEST_ASSERT_DOUBLE_WITHIN(0.001, b_act, c.b_actual_nm / 1e6);
-    TEST_ASSERT_DOUBLE_WITHIN(2e-6, 2.0 / (ed + 1.0), q30(c.cl_q30));        /* Eq. 6.33 */
-    TEST_ASSERT_DOUBLE_WITHIN(2e-6, 2.0 / (1.0 / ed + 1.0), q30(c.cr_q30));  /* Eq. 6.34 */
+    TEST_ASSERT_DOUBLE_WITHIN(2e-6, 2.0 / (ed + 1.0), q30(c.cl_q30));       /* Eq. 6.33 */
+    TEST_ASSERT_DOUBLE_WITHIN(2e-6, 2.0 / (1.0 / ed + 1.0), q30(c.cr_q30)); /* Eq. 6.34 */
     /* Eq. 6.23: R = (L/2) / sin(beta/2), negative for a right-curving leg. */
-    TEST_ASSERT_DOUBLE_WITHIN(1.0, 2000.0 / sin(beta / 2.0), c.radius_um / 1000.0);
+    TEST_ASSERT_DOUBLE_WITHIN(1.0, 2000.0 / sin(beta / 2.0), (double)c.radius_um / 1000.0);
     /* The mean wheel diameter is kept (Eq. 6.30): cL + cR = 2. */
     TEST_ASSERT_DOUBLE_WITHIN(3e-9, 2.0, q30(c.cl_q30) + q30(c.cr_q30));
 }
@@ -163,8 +163,8 @@ static void zero_errors_leave_the_calibration_unchanged(void)
     odo_umb_stats_t s;
     odo_umb_calib_t c;
     TEST_ASSERT_EQUAL(ODO_UMB_OK, odo_umb_stats(cw, 2, ccw, 2, &s));
-    TEST_ASSERT_EQUAL(ODO_UMB_OK, odo_umb_calibrate(&s, 4000000U, 340000000U, ODO_RATIO_Q30_ONE,
-                                                    ODO_RATIO_Q30_ONE, &c));
+    TEST_ASSERT_EQUAL(ODO_UMB_OK,
+                      odo_umb_calibrate(&s, 4000000U, 340000000U, ODO_RATIO_Q30_ONE, ODO_RATIO_Q30_ONE, &c));
     TEST_ASSERT_EQUAL_INT32(0, c.alpha_bam);
     TEST_ASSERT_EQUAL_INT32(0, c.beta_bam);
     TEST_ASSERT_EQUAL_INT64(0, c.radius_um);
@@ -179,7 +179,7 @@ static void zero_errors_leave_the_calibration_unchanged(void)
 /// removed, averaged as absolute values (so +1 deg and -1 deg do not cancel).
 static void nonsystematic_metric_removes_each_directions_bias(void)
 {
-    odo_umb_return_t cw[2] = {{0, 0, 3000000}, {0, 0, 1000000}};   /* bias 2 deg: |1| + |-1| */
+    odo_umb_return_t cw[2] = {{0, 0, 3000000}, {0, 0, 1000000}};    /* bias 2 deg: |1| + |-1| */
     odo_umb_return_t ccw[2] = {{0, 0, -5000000}, {0, 0, -1000000}}; /* bias -3 deg: |-2| + |2| */
     const int32_t bias[2] = {2000000, -3000000};
     uint32_t v = 0;
@@ -231,6 +231,71 @@ static void bad_input_is_refused_with_a_status(void)
     TEST_ASSERT_TRUE(strcmp(odo_umb_status_str(ODO_UMB_ERR_SIDE), odo_umb_status_str(ODO_UMB_ERR_INPUT)) != 0);
 }
 
+/// Every bound of the header's contract (odo_umbmark.h) refuses exactly past it, each argument's
+/// NULL included, and the extended-UMBmark metric wraps the difference to its direction's bias
+/// into [-180, 180] deg both ways (000 Eq. 3.5).
+static void every_documented_bound_is_enforced(void)
+{
+    odo_umb_return_t ok[2] = {{0, 0, 0}, {0, 0, 0}};
+    odo_umb_return_t bad[2] = {{0, 0, 0}, {0, 0, 0}};
+    odo_umb_stats_t s;
+    TEST_ASSERT_EQUAL(ODO_UMB_ERR_ARG, odo_umb_stats(ok, 2, NULL, 2, &s));
+    TEST_ASSERT_EQUAL(ODO_UMB_ERR_FEW_RUNS, odo_umb_stats(ok, ODO_UMB_MAX_RUNS + 1U, ok, 2, &s));
+    const int32_t m = ODO_UMB_MAX_ERR_UM, t = ODO_UMB_MAX_THETA_UDEG;
+    const odo_umb_return_t edges[][1] = {
+        {{-m - 1, 0, 0}}, {{m + 1, 0, 0}}, {{0, -m - 1, 0}}, {{0, 0, -t - 1}}, {{0, 0, t + 1}}};
+    for (size_t k = 0; k < sizeof edges / sizeof edges[0]; ++k) {
+        bad[1] = edges[k][0];
+        TEST_ASSERT_EQUAL(ODO_UMB_ERR_INPUT, odo_umb_stats(ok, 2, bad, 2, &s));
+    }
+    const odo_umb_return_t at_edge[2] = {{-m, m, -t}, {m, -m, t}};
+    TEST_ASSERT_EQUAL(ODO_UMB_OK, odo_umb_stats(at_edge, 2, ok, 2, &s));
+
+    int32_t cl = 0, cr = 0;
+    TEST_ASSERT_FALSE(odo_umb_correction_factors(ODO_RATIO_Q30_ONE, NULL, &cr));
+    TEST_ASSERT_FALSE(odo_umb_correction_factors(ODO_RATIO_Q30_ONE, &cl, NULL));
+    TEST_ASSERT_TRUE(odo_umb_correction_factors(ODO_RATIO_Q30_ONE, &cl, &cr));
+    TEST_ASSERT_EQUAL_INT32(ODO_RATIO_Q30_ONE, cl); /* Ed = 1: both factors exactly 1 */
+    TEST_ASSERT_EQUAL_INT32(ODO_RATIO_Q30_ONE, cr);
+
+    TEST_ASSERT_EQUAL(ODO_UMB_OK, odo_umb_stats(ok, 2, ok, 2, &s));
+    odo_umb_calib_t c;
+    const int32_t one = ODO_RATIO_Q30_ONE;
+    TEST_ASSERT_EQUAL(ODO_UMB_ERR_ARG, odo_umb_calibrate(&s, 4000000U, 340000000U, one, one, NULL));
+    TEST_ASSERT_EQUAL(ODO_UMB_ERR_GEOMETRY, odo_umb_calibrate(&s, 4000000U, 4000000000U, one, one, &c));
+    TEST_ASSERT_EQUAL(ODO_UMB_ERR_GEOMETRY, odo_umb_calibrate(&s, 4000000U, 340000000U, one + one / 2, one, &c));
+    TEST_ASSERT_EQUAL(ODO_UMB_ERR_GEOMETRY, odo_umb_calibrate(&s, 4000000U, 340000000U, one, one / 2, &c));
+    TEST_ASSERT_EQUAL(ODO_UMB_ERR_GEOMETRY, odo_umb_calibrate(&s, 4000000U, 340000000U, one, one + one / 2, &c));
+    TEST_ASSERT_EQUAL(ODO_UMB_OK, odo_umb_calibrate(&s, 4000000U, 340000000U, one, one, &c));
+
+    const int32_t bias[2] = {0, 0}, bad_bias[2] = {0, t + 1};
+    uint32_t e = 0U;
+    TEST_ASSERT_EQUAL(ODO_UMB_ERR_ARG, odo_umb_nonsys_theta(NULL, 1, ok, 1, bias, &e));
+    TEST_ASSERT_EQUAL(ODO_UMB_ERR_ARG, odo_umb_nonsys_theta(ok, 1, NULL, 1, bias, &e));
+    TEST_ASSERT_EQUAL(ODO_UMB_ERR_ARG, odo_umb_nonsys_theta(ok, 1, ok, 1, NULL, &e));
+    TEST_ASSERT_EQUAL(ODO_UMB_ERR_ARG, odo_umb_nonsys_theta(ok, 1, ok, 1, bias, NULL));
+    TEST_ASSERT_EQUAL(ODO_UMB_ERR_FEW_RUNS, odo_umb_nonsys_theta(ok, 0, ok, 0, bias, &e));
+    TEST_ASSERT_EQUAL(ODO_UMB_ERR_FEW_RUNS, odo_umb_nonsys_theta(ok, ODO_UMB_MAX_RUNS + 1U, ok, 1, bias, &e));
+    TEST_ASSERT_EQUAL(ODO_UMB_ERR_FEW_RUNS, odo_umb_nonsys_theta(ok, 1, ok, ODO_UMB_MAX_RUNS + 1U, bias, &e));
+    TEST_ASSERT_EQUAL(ODO_UMB_ERR_INPUT, odo_umb_nonsys_theta(ok, 1, ok, 1, bad_bias, &e));
+    bad[0].etheta_udeg = -t - 1;
+    TEST_ASSERT_EQUAL(ODO_UMB_ERR_INPUT, odo_umb_nonsys_theta(bad, 1, ok, 1, bias, &e));
+    /* 179 deg against a bias of -179 deg is 2 deg away across the wrap, not 358; and back. */
+    const odo_umb_return_t near_wrap[2] = {{0, 0, 179000000}, {0, 0, -179000000}};
+    const int32_t opposite[2] = {-179000000, 179000000};
+    TEST_ASSERT_EQUAL(ODO_UMB_OK, odo_umb_nonsys_theta(&near_wrap[0], 1, &near_wrap[1], 1, opposite, &e));
+    TEST_ASSERT_EQUAL_UINT32(2000000U, e);
+
+    const odo_umb_status_t all[] = {ODO_UMB_OK,       ODO_UMB_ERR_ARG,      ODO_UMB_ERR_FEW_RUNS, ODO_UMB_ERR_INPUT,
+                                    ODO_UMB_ERR_SIDE, ODO_UMB_ERR_GEOMETRY, ODO_UMB_ERR_RESULT};
+    for (size_t i = 0; i < sizeof all / sizeof all[0]; ++i) {
+        for (size_t j = 0; j < i; ++j) {
+            TEST_ASSERT_TRUE(strcmp(odo_umb_status_str(all[i]), odo_umb_status_str(all[j])) != 0);
+        }
+    }
+    TEST_ASSERT_EQUAL_STRING("unknown status", odo_umb_status_str((odo_umb_status_t)99));
+}
+
 /// The extremes of the documented input ranges do not overflow: 256 runs per direction at
 /// +-33.5 m give the exact cg and spread.
 static void extremes_of_the_input_range_stay_exact(void)
@@ -261,6 +326,7 @@ int main(void)
     RUN_TEST(zero_errors_leave_the_calibration_unchanged);
     RUN_TEST(nonsystematic_metric_removes_each_directions_bias);
     RUN_TEST(bad_input_is_refused_with_a_status);
+    RUN_TEST(every_documented_bound_is_enforced);
     RUN_TEST(extremes_of_the_input_range_stay_exact);
     return UNITY_END();
 }

@@ -25,16 +25,16 @@
 
 typedef struct {
     odo_can_frame_t f;
-    uint64_t        t_us;
+    uint64_t t_us;
 } tframe_t;
 
 /// One simulator run: its sensor log (a temp file) and what the firmware published each tick.
 typedef struct {
-    char            log_path[64];
+    char log_path[64];
     odo_can_frame_t out[MAX_FRAMES];
-    uint32_t        n_out;
-    uint32_t        ticks;
-    FILE           *log;
+    uint32_t n_out;
+    uint32_t ticks;
+    FILE *log;
 } sim_capture_t;
 
 static sim_capture_t g_sim[2]; /* [ipec off, on] */
@@ -93,8 +93,15 @@ static void run_sim(int ipec)
     snprintf(c->log_path, sizeof c->log_path, "/tmp/odo-replay-sim-%d-%ld.log", ipec, (long)getpid());
     c->log = fopen(c->log_path, "w");
     need(c->log != NULL, c->log_path);
-    sim_run_config_t cfg = {.robot = &robot, .scenario = &sc, .experiment = "straight-36m", .ccw = 0,
-                            .bumps = -1, .bump_height_mm = 10.0, .ipec = ipec, .seed = 7U, .run_index = 0};
+    sim_run_config_t cfg = {.robot = &robot,
+                            .scenario = &sc,
+                            .experiment = "straight-36m",
+                            .ccw = 0,
+                            .bumps = -1,
+                            .bump_height_mm = 10.0,
+                            .ipec = ipec,
+                            .seed = 7U,
+                            .run_index = 0};
     sim_return_t ret;
     need(sim_run(&cfg, on_sim_tick, c, &ret, err, sizeof err) == 0, err);
     need(fclose(c->log) == 0, c->log_path);
@@ -105,12 +112,12 @@ static void run_sim(int ipec)
 /// What a replay produced.
 typedef struct {
     odo_can_frame_t out[MAX_FRAMES];
-    uint32_t        n_out;
-    uint32_t        ticks;
-    uint32_t        faults_or;                 ///< OR of every tick's fault bits
-    uint32_t        ticks_with[32];            ///< ticks that raised each fault bit
-    uint32_t        status_faults[MAX_TICKS];  ///< Faults of each tick's STATUS frame
-    odo_pose_t      pose[MAX_TICKS][ODO_TRUCKS];
+    uint32_t n_out;
+    uint32_t ticks;
+    uint32_t faults_or;                ///< OR of every tick's fault bits
+    uint32_t ticks_with[32];           ///< ticks that raised each fault bit
+    uint32_t status_faults[MAX_TICKS]; ///< Faults of each tick's STATUS frame
+    odo_pose_t pose[MAX_TICKS][ODO_TRUCKS];
 } run_t;
 
 static void on_replay_tick(void *user, replay_t *r, uint64_t tick, const odo_tick_input_t *in,
@@ -220,7 +227,8 @@ static void report(const char *what, const run_t *bad)
     deviation(&g_run_a, bad, 0, &max_a, &end_a);
     deviation(&g_run_a, bad, 1, &max_b, &end_b);
     printf("fault %-28s pose deviation from the clean replay: A max %.3f end %.3f mm, B max %.3f end %.3f mm; "
-           "status faults 0x%05X\n", what, max_a, end_a, max_b, end_b, bad->faults_or);
+           "status faults 0x%05X\n",
+           what, max_a, end_a, max_b, end_b, bad->faults_or);
 }
 
 static double end_dev(const run_t *bad, unsigned t)
@@ -496,9 +504,9 @@ START_TEST(gaps_of_1e5_and_1e12_seconds_are_skipped_and_the_reading_across_them_
         ck_assert(g_run_b.status_faults[500] & ODO_FAULT_COUNTER_JUMP_B);
         ck_assert_uint_eq(g_run_b.ticks_with[1], 1U); /* only that tick */
         for (unsigned t = 0; t < 2U; ++t) {
-            const double tick_travel =
-                hypot((double)(g_run_a.pose[500][t].x_mm_q32 - g_run_a.pose[499][t].x_mm_q32),
-                      (double)(g_run_a.pose[500][t].y_mm_q32 - g_run_a.pose[499][t].y_mm_q32)) / 4294967296.0;
+            const double tick_travel = hypot((double)(g_run_a.pose[500][t].x_mm_q32 - g_run_a.pose[499][t].x_mm_q32),
+                                             (double)(g_run_a.pose[500][t].y_mm_q32 - g_run_a.pose[499][t].y_mm_q32)) /
+                                       4294967296.0;
             ck_assert_double_gt(tick_travel, 5.0);
             ck_assert_double_lt(fabs(end_dev(&g_run_b, t) - tick_travel), 0.5);
         }

@@ -14,6 +14,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "odo_cli.h"
 #include "odo/odo_app.h"
 #include "odo_refcheck.h"
 #include "odo_synth.h"
@@ -26,30 +27,30 @@
 
 static void usage(FILE *f)
 {
-    fprintf(f,
-            "usage: odo-bench [--json] [--quick]\n"
-            "\n"
-            "Prints the firmware's benchmark figures:\n"
-            "  pos_err_mm_1km, heading_err_rad_1km  fixed point vs double after 1 km of mixed\n"
-            "                                       driving (worst of 6 runs; targets 0.1, 1e-6)\n"
-            "  pos_err_mm_1km_scrub, heading_err_rad_1km_scrub  the same with the tyre-scrub\n"
-            "                                       term on, k = +-0.01 and +-0.2 (worst of 8 runs)\n"
-            "  sincos_max_abs_err, atan2_max_abs_err_rad  vs libm over 10^6 random inputs + edges\n"
-            "  ipec_step_instructions               the same with IPEC on (paper form, every tick)\n"
-            "  step_instructions                    x86-64 instructions per 40 ms application\n"
-            "                                       step for two trucks, counted by callgrind\n"
-            "  scrub_step_instructions              the same with scrub k = 0.0095 on both trucks\n"
-            "  scrub_arc_step_instructions          the same on arcs only (the term's worst case)\n"
-            "  sim_umbmark_10runs_s                 wall seconds for the 10-run UMBmark set of the\n"
-            "                                       000 s. 4.6.2 robot at 1 ms physics, firmware in\n"
-            "                                       the loop (target < 1 s on one core)\n"
-            "  sim_realtime_factor                  simulated seconds per wall second in that set\n"
-            "  replay_ticks_per_s                   odo-replay's offline loop (parse, assemble, step,\n"
-            "                                       output lines) on a 1-hour clapper sim log\n"
-            "  replay_vs_python_can_ratio           its frames/s over python-can's CanutilsLogReader\n"
-            "                                       merely reading the same file (target >= 20)\n"
-            "  --json   one JSON object on stdout (progress goes to stderr)\n"
-            "  --quick  fewer samples (for smoke tests; figures are then indicative only)\n");
+    fprintf(f, "usage: odo-bench [--json] [--quick]\n"
+               "       odo-bench --help | --version\n"
+               "\n"
+               "Prints the firmware's benchmark figures:\n"
+               "  pos_err_mm_1km, heading_err_rad_1km  fixed point vs double after 1 km of mixed\n"
+               "                                       driving (worst of 6 runs; targets 0.1, 1e-6)\n"
+               "  pos_err_mm_1km_scrub, heading_err_rad_1km_scrub  the same with the tyre-scrub\n"
+               "                                       term on, k = +-0.01 and +-0.2 (worst of 8 runs)\n"
+               "  sincos_max_abs_err, atan2_max_abs_err_rad  vs libm over 10^6 random inputs + edges\n"
+               "  ipec_step_instructions               the same with IPEC on (paper form, every tick)\n"
+               "  step_instructions                    x86-64 instructions per 40 ms application\n"
+               "                                       step for two trucks, counted by callgrind\n"
+               "  scrub_step_instructions              the same with scrub k = 0.0095 on both trucks\n"
+               "  scrub_arc_step_instructions          the same on arcs only (the term's worst case)\n"
+               "  sim_umbmark_10runs_s                 wall seconds for the 10-run UMBmark set of the\n"
+               "                                       000 s. 4.6.2 robot at 1 ms physics, firmware in\n"
+               "                                       the loop (target < 1 s on one core)\n"
+               "  sim_realtime_factor                  simulated seconds per wall second in that set\n"
+               "  replay_ticks_per_s                   odo-replay's offline loop (parse, assemble, step,\n"
+               "                                       output lines) on a 1-hour clapper sim log\n"
+               "  replay_vs_python_can_ratio           its frames/s over python-can's CanutilsLogReader\n"
+               "                                       merely reading the same file (target >= 20)\n"
+               "  --json   one JSON object on stdout (progress goes to stderr)\n"
+               "  --quick  fewer samples (for smoke tests; figures are then indicative only)\n");
 }
 
 typedef enum { KERNEL_PLAIN, KERNEL_IPEC, KERNEL_SCRUB, KERNEL_SCRUB_ARC } kernel_t;
@@ -64,7 +65,7 @@ static int run_kernel(kernel_t kind)
     odo_params_defaults(&p);
     p.vehicle = ODO_VEHICLE_CLAPPER;
     p.ipec_mode = (uint8_t)(ipec ? ODO_IPEC_PAPER : ODO_IPEC_OFF); /* --kernel-ipec: 002 Eqs. 9-16 */
-    if (kind == KERNEL_SCRUB || kind == KERNEL_SCRUB_ARC) { /* the OptiOdom robot's k */
+    if (kind == KERNEL_SCRUB || kind == KERNEL_SCRUB_ARC) {        /* the OptiOdom robot's k */
         p.truck[0].scrub_q30 = p.truck[1].scrub_q30 = (int32_t)llround(0.0095 * 1073741824.0);
     }
     if (odo_app_init_params(&app, &p) != ODO_PARAMS_OK) {
@@ -160,7 +161,7 @@ static double now_s(void)
 {
     struct timespec ts;
     clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + ts.tv_nsec * 1e-9;
+    return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
 }
 
 /// The 10-run UMBmark set (5 cw, 5 ccw) of the 000 s. 4.6.2 robot (b 337 vs 340 mm, Ed 0.9985,
@@ -184,8 +185,14 @@ static double sim_umbmark_10runs(double *sim_s)
     const double t0 = now_s();
     for (int d = 0; d < 2; ++d) {
         for (unsigned k = 0; k < 5U; ++k) {
-            sim_run_config_t cfg = {.robot = &robot, .scenario = &sc, .experiment = "umbmark", .ccw = d,
-                                    .bumps = -1, .bump_height_mm = 10.0, .seed = 100U + k, .run_index = k};
+            sim_run_config_t cfg = {.robot = &robot,
+                                    .scenario = &sc,
+                                    .experiment = "umbmark",
+                                    .ccw = d,
+                                    .bumps = -1,
+                                    .bump_height_mm = 10.0,
+                                    .seed = 100U + k,
+                                    .run_index = k};
             sim_return_t ret;
             if (sim_run(&cfg, NULL, NULL, &ret, err, sizeof err) != 0) {
                 fprintf(stderr, "odo-bench: %s\n", err);
@@ -216,6 +223,9 @@ int main(int argc, char **argv)
         } else if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
             usage(stdout);
             return 0;
+        } else if (strcmp(argv[i], "--version") == 0) {
+            odo_cli_print_version("odo-bench");
+            return 0;
         } else {
             fprintf(stderr, "odo-bench: unknown argument '%s'\n\n", argv[i]);
             usage(stderr);
@@ -230,8 +240,8 @@ int main(int argc, char **argv)
     odo_params_defaults(&p);
     for (int run = 0; run < (quick ? 2 : 6); ++run) {
         odo_refcheck_t r;
-        if (odo_refcheck_run(1000U + (uint64_t)run, widths[run % 3], (uint8_t)(run / 3), &p.truck[0],
-                             &p.truck[0], 1.0e6, &r) != 0) {
+        if (odo_refcheck_run(1000U + (uint64_t)run, widths[run % 3], (uint8_t)(run / 3), &p.truck[0], &p.truck[0],
+                             1.0e6, &r) != 0) {
             fprintf(stderr, "odo-bench: default parameters refused by the model\n");
             return 1;
         }
@@ -291,8 +301,8 @@ int main(int argc, char **argv)
             printf("\"scrub_step_instructions\": null, \"scrub_arc_step_instructions\": null, ");
         }
         if (sim_wall >= 0.0) {
-            printf("\"sim_umbmark_10runs_s\": %.4f, \"sim_realtime_factor\": %.0f, \"sim_seconds\": %.1f, ",
-                   sim_wall, sim_s / sim_wall, sim_s);
+            printf("\"sim_umbmark_10runs_s\": %.4f, \"sim_realtime_factor\": %.0f, \"sim_seconds\": %.1f, ", sim_wall,
+                   sim_s / sim_wall, sim_s);
         } else {
             printf("\"sim_umbmark_10runs_s\": null, \"sim_realtime_factor\": null, ");
         }
@@ -316,8 +326,7 @@ int main(int argc, char **argv)
                "\"atan2_max_abs_err_rad\": 1e-07, \"sim_umbmark_10runs_s\": 1.0, "
                "\"replay_vs_python_can_ratio\": 20}}\n");
     } else {
-        printf("fixed vs double, 1 km     position %.3g mm (target <= 0.1)  heading %.3g rad (<= 1e-6)\n",
-               pos, head);
+        printf("fixed vs double, 1 km     position %.3g mm (target <= 0.1)  heading %.3g rad (<= 1e-6)\n", pos, head);
         printf("  with scrub k +-0.01/0.2 position %.3g mm  heading %.3g rad\n", pos_scrub, head_scrub);
         printf("sin/cos max abs error     %.3g (target <= 2e-8)\n", sc);
         printf("atan2 max abs error       %.3g rad (target <= 1e-7)\n", at);

@@ -74,7 +74,6 @@ int main(void)
         run++;
     }
     fclose(f);
-    printf("odo_bench: %lu ticks, %lu outputs differ from the host's\n", (unsigned long)run,
-           (unsigned long)bad);
+    printf("odo_bench: %lu ticks, %lu outputs differ from the host's\n", (unsigned long)run, (unsigned long)bad);
     return bad == 0U ? 0 : 1;
 }

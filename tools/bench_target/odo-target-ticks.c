@@ -20,9 +20,9 @@
 #include "robot.h"
 
 typedef struct {
-    FILE    *f;
+    FILE *f;
     uint32_t ticks;
-    bool     io_error;
+    bool io_error;
 } sink_t;
 
 static void on_tick(void *user, struct replay *r, uint64_t tick, const odo_tick_input_t *in,
@@ -82,7 +82,8 @@ int main(int argc, char **argv)
     odo_params_t p;
     char err[512];
     static sim_robot_t rob;
-    if (sim_robot_parse_file(robot, &rob, err, sizeof err) != 0 || sim_robot_to_params(&rob, &p, err, sizeof err) != 0) {
+    if (sim_robot_parse_file(robot, &rob, err, sizeof err) != 0 ||
+        sim_robot_to_params(&rob, &p, err, sizeof err) != 0) {
         fprintf(stderr, "odo-target-ticks: %s\n", err);
         return 1;
     }
@@ -124,7 +125,8 @@ int main(int argc, char **argv)
     put32(hdr + 4, ODO_BENCH_FILE_VERSION);
     put32(hdr + 8, 0U); /* tick count, written at the end */
     put32(hdr + 12, (uint32_t)sizeof block);
-    sink.io_error = fwrite(hdr, 1, sizeof hdr, sink.f) != sizeof hdr || fwrite(block, 1, sizeof block, sink.f) != sizeof block;
+    sink.io_error =
+        fwrite(hdr, 1, sizeof hdr, sink.f) != sizeof hdr || fwrite(block, 1, sizeof block, sink.f) != sizeof block;
 
     static replay_t r;
     const odo_params_status_t st = replay_init(&r, &p, on_tick, &sink);

@@ -28,8 +28,8 @@
 #include "robot.h"
 #include "sil.h"
 
-#define Q30 1073741824.0
-#define SIDE_MM 4000.0 /* host_sim's umbmark square (000 s. 3.5) */
+#define Q30        1073741824.0
+#define SIDE_MM    4000.0 /* host_sim's umbmark square (000 s. 3.5) */
 #define MAX_ROBOTS 200
 
 static uint64_t splitmix(uint64_t *s)
@@ -46,15 +46,22 @@ static double uniform(uint64_t *s, double lo, double hi)
 }
 
 /// `runs` runs each way of the umbmark square; returns in *r (000 Eq. 3.1).
-static int run_umbmark(const sim_robot_t *robot, const sim_scenario_t *sc, unsigned runs, uint64_t seed,
-                       returns_t *r, char *err, size_t errlen)
+static int run_umbmark(const sim_robot_t *robot, const sim_scenario_t *sc, unsigned runs, uint64_t seed, returns_t *r,
+                       char *err, size_t errlen)
 {
     memset(r, 0, sizeof *r);
     for (int d = 0; d < 2; ++d) {
         for (unsigned k = 0; k < runs; ++k) {
             const sim_run_config_t cfg = {
-                .robot = robot, .scenario = sc, .experiment = "umbmark", .ccw = d, .bumps = -1,
-                .bump_height_mm = 10.0, .ipec = 0, .seed = sim_run_seed(seed, d, k), .run_index = k,
+                .robot = robot,
+                .scenario = sc,
+                .experiment = "umbmark",
+                .ccw = d,
+                .bumps = -1,
+                .bump_height_mm = 10.0,
+                .ipec = 0,
+                .seed = sim_run_seed(seed, d, k),
+                .run_index = k,
             };
             sim_return_t ret;
             if (sim_run(&cfg, NULL, NULL, &ret, err, errlen) != 0) {
@@ -111,9 +118,9 @@ typedef struct {
 } robot_result_t;
 
 /// Calibrate from `r` with params `in_force`, run again; `passes` times. Returns 0 or -1.
-static int calibrate_and_rerun(const sim_robot_t *base, const sim_scenario_t *sc, const returns_t *first,
-                               unsigned runs, uint64_t seed, calib_method_t m, unsigned passes, robot_result_t *rr,
-                               char *err, size_t errlen)
+static int calibrate_and_rerun(const sim_robot_t *base, const sim_scenario_t *sc, const returns_t *first, unsigned runs,
+                               uint64_t seed, calib_method_t m, unsigned passes, robot_result_t *rr, char *err,
+                               size_t errlen)
 {
     static returns_t r;
     r = *first;
@@ -152,7 +159,7 @@ static int cmp_double(const void *a, const void *b)
 static double median(double *v, size_t n)
 {
     qsort(v, n, sizeof *v, cmp_double);
-    return n == 0 ? NAN : (n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]));
+    return n == 0 ? (double)NAN : (n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]));
 }
 
 static int make_scenario(sim_scenario_t *sc, double ed, double eb, double es, int rough, uint64_t seed, char *err,
@@ -203,9 +210,11 @@ int calib_acceptance_main(int argc, char **argv)
             errno = 0;
             const char *v = argv[++i];
             const unsigned long long x = strtoull(v, &end, 10);
-            const unsigned long long hi = strcmp(a, "--robots") == 0 ? MAX_ROBOTS : strcmp(a, "--runs") == 0 ? 100 : UINT64_MAX;
-            if (errno != 0 || end == v || *end != '\0' || v[0] == '-' || (strcmp(a, "--seed") != 0 && (x < 1 || x > hi)) ||
-                (strcmp(a, "--runs") == 0 && x < 2)) {
+            const unsigned long long hi = strcmp(a, "--robots") == 0 ? MAX_ROBOTS
+                                          : strcmp(a, "--runs") == 0 ? 100
+                                                                     : UINT64_MAX;
+            if (errno != 0 || end == v || *end != '\0' || v[0] == '-' ||
+                (strcmp(a, "--seed") != 0 && (x < 1 || x > hi)) || (strcmp(a, "--runs") == 0 && x < 2)) {
                 fprintf(stderr, "odo-calib acceptance: %s: '%s' is not valid (robots 1-%d, runs 2-100)\n", a, v,
                         MAX_ROBOTS);
                 return 2;
@@ -260,10 +269,11 @@ int calib_acceptance_main(int argc, char **argv)
         nf_ed_max = fmax(nf_ed_max, fabs(c.fit.ed - rr->ed_true));
         nf_b_max = fmax(nf_b_max, fabs(c.fit.b_mm - rr->b_true));
         if (!quiet) {
-            fprintf(stderr, "odo-calib acceptance: robot %2ld/%ld  Ed %.5f  b %.2f mm  Emax,syst %7.1f -> exact %5.1f, "
-                            "paper %6.1f mm   noise-free dEd %.1e db %.4f mm\n", i + 1, n_robots, rr->ed_true,
-                    rr->b_true, rr->before.emax_mm, rr->after[CALIB_EXACT][0].emax_mm, rr->after[CALIB_PAPER][0].emax_mm,
-                    fabs(c.fit.ed - rr->ed_true), fabs(c.fit.b_mm - rr->b_true));
+            fprintf(stderr,
+                    "odo-calib acceptance: robot %2ld/%ld  Ed %.5f  b %.2f mm  Emax,syst %7.1f -> exact %5.1f, "
+                    "paper %6.1f mm   noise-free dEd %.1e db %.4f mm\n",
+                    i + 1, n_robots, rr->ed_true, rr->b_true, rr->before.emax_mm, rr->after[CALIB_EXACT][0].emax_mm,
+                    rr->after[CALIB_PAPER][0].emax_mm, fabs(c.fit.ed - rr->ed_true), fabs(c.fit.b_mm - rr->b_true));
         }
     }
     /* Summary. */
@@ -312,8 +322,10 @@ int calib_acceptance_main(int argc, char **argv)
             if (make_scenario(&sc, tp[k].ed, eb0, tp[k].es, 1, tseed, err, sizeof err) != 0 ||
                 run_umbmark(&base, &sc, (unsigned)runs, tseed, &first, err, sizeof err) != 0 ||
                 stats_of(&first, &tp[k].before, err, sizeof err) != 0 ||
-                calibrate_and_rerun(&base, &sc, &first, (unsigned)runs, tseed, CALIB_EXACT, 2, &tp[k].rr, err, sizeof err) != 0 ||
-                calibrate_and_rerun(&base, &sc, &first, (unsigned)runs, tseed, CALIB_PAPER, 2, &tp[k].rr, err, sizeof err) != 0) {
+                calibrate_and_rerun(&base, &sc, &first, (unsigned)runs, tseed, CALIB_EXACT, 2, &tp[k].rr, err,
+                                    sizeof err) != 0 ||
+                calibrate_and_rerun(&base, &sc, &first, (unsigned)runs, tseed, CALIB_PAPER, 2, &tp[k].rr, err,
+                                    sizeof err) != 0) {
                 fprintf(stderr, "odo-calib acceptance: %s: %s\n", tp[k].name, err);
                 return 1;
             }
@@ -349,9 +361,10 @@ int calib_acceptance_main(int argc, char **argv)
             const tape_t *t = &tp[k];
             printf("%s\n  {\"experiment\": \"%s\", \"what\": \"%s\", \"ed_true\": %.6f, \"es_true\": %.6f, "
                    "\"emax_before_mm\": %.3f, \"exact_after_mm\": [%.3f, %.3f], \"paper_after_mm\": [%.3f, %.3f], "
-                   "\"sem_after_exact_mm\": %.3f}", k ? "," : "", t->name, t->what, t->ed, t->es, t->before.emax_mm,
-                   t->rr.after[1][0].emax_mm, t->rr.after[1][1].emax_mm, t->rr.after[0][0].emax_mm,
-                   t->rr.after[0][1].emax_mm, t->rr.after[1][0].sem_mm);
+                   "\"sem_after_exact_mm\": %.3f}",
+                   k ? "," : "", t->name, t->what, t->ed, t->es, t->before.emax_mm, t->rr.after[1][0].emax_mm,
+                   t->rr.after[1][1].emax_mm, t->rr.after[0][0].emax_mm, t->rr.after[0][1].emax_mm,
+                   t->rr.after[1][0].sem_mm);
         }
         printf("]}\n");
     } else {

@@ -22,8 +22,10 @@ int calib_umbmark(const returns_t *r, double side_mm, const odo_params_t *in_for
     }
     for (int d = 0; d < 2; ++d) {
         if (r->n[d] < 2) {
-            snprintf(err, errlen, "%zu %s run%s: UMBmark needs at least 2 runs in each direction (000 s. 3.5 "
-                                  "asks for 5)", r->n[d], d ? "ccw" : "cw", r->n[d] == 1 ? "" : "s");
+            snprintf(err, errlen,
+                     "%zu %s run%s: UMBmark needs at least 2 runs in each direction (000 s. 3.5 "
+                     "asks for 5)",
+                     r->n[d], d ? "ccw" : "cw", r->n[d] == 1 ? "" : "s");
             return -1;
         }
     }
@@ -54,8 +56,8 @@ int calib_umbmark(const returns_t *r, double side_mm, const odo_params_t *in_for
         const umb_setup_t su = {side_um / 1000.0, b_nom, out->ed_in_force, out->eb_in_force};
         const double cg[2][2] = {{out->st.cg_x_um[0] / 1000.0, out->st.cg_y_um[0] / 1000.0},
                                  {out->st.cg_x_um[1] / 1000.0, out->st.cg_y_um[1] / 1000.0}};
-        if (umb_exact_fit(&su, cg, out->paper.ed_q30 / Q30, out->paper.b_actual_nm / 1e6, &out->fit, err,
-                          errlen) != 0) {
+        if (umb_exact_fit(&su, cg, out->paper.ed_q30 / Q30, (double)out->paper.b_actual_nm / 1e6, &out->fit, err,
+                          errlen > UINT32_MAX ? UINT32_MAX : (unsigned)errlen) != 0) {
             return -1;
         }
         const double ed = out->fit.ed * Q30, eb = out->fit.b_mm / b_nom * Q30;

@@ -15,14 +15,14 @@
 typedef enum { CALIB_PAPER = 0, CALIB_EXACT = 1 } calib_method_t;
 
 typedef struct {
-    calib_method_t  method;
+    calib_method_t method;
     odo_umb_stats_t st;
-    odo_umb_calib_t paper;     ///< always computed (the start of the exact fit)
-    umb_fit_t       fit;       ///< method exact only
-    int32_t         ed_q30, eb_q30; ///< the new parameter block values of the chosen method
-    int32_t         cl_q30, cr_q30;
-    double          b_actual_mm;
-    double          ed_in_force, eb_in_force;
+    odo_umb_calib_t paper;  ///< always computed (the start of the exact fit)
+    umb_fit_t fit;          ///< method exact only
+    int32_t ed_q30, eb_q30; ///< the new parameter block values of the chosen method
+    int32_t cl_q30, cr_q30;
+    double b_actual_mm;
+    double ed_in_force, eb_in_force;
 } calib_result_t;
 
 /// Calibrate truck A of `in_force` (the parameter block the robot ran the test with) from the

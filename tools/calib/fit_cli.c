@@ -63,35 +63,6 @@ static int take_list(int argc, char **argv, int *i, const char **dst, size_t *n,
     return 0;
 }
 
-/* Is `out` one of the inputs: the robot file, or a file a --runs folder holds that fit reads? */
-static int is_input(const char *out, const char *robot, const char *const *runs, size_t n_runs)
-{
-    char ro[PATH_MAX], rr[PATH_MAX], dir[PATH_MAX], rd[PATH_MAX], rdir[PATH_MAX];
-    if (realpath(robot, rr) != NULL && realpath(out, ro) != NULL && strcmp(ro, rr) == 0) {
-        return 1;
-    }
-    snprintf(dir, sizeof dir, "%s", out);
-    char *slash = strrchr(dir, '/');
-    const char *base = slash != NULL ? slash + 1 : out;
-    if (slash != NULL) {
-        *slash = '\0';
-    } else {
-        snprintf(dir, sizeof dir, ".");
-    }
-    if (realpath(dir, rd) == NULL) {
-        return 0;
-    }
-    const int read_by_fit = strcmp(base, "robot.json") == 0 || strcmp(base, "returns.csv") == 0 ||
-                            (strncmp(base, "run-", 4) == 0 && (strstr(base, ".log") != NULL ||
-                                                               strstr(base, ".truth.csv") != NULL));
-    for (size_t k = 0; k < n_runs && read_by_fit; ++k) {
-        if (realpath(runs[k], rdir) != NULL && strcmp(rdir, rd) == 0) {
-            return 1;
-        }
-    }
-    return 0;
-}
-
 typedef struct {
     double before_pos, after_pos, before_th, after_th;
     size_t n;
@@ -153,10 +124,14 @@ int calib_fit_main(int argc, char **argv)
         char buf[128];
         snprintf(buf, sizeof buf, "%s", free_list);
         for (char *tok = strtok(buf, ","); tok != NULL; tok = strtok(NULL, ",")) {
-            if (strcmp(tok, "ed") == 0) fr.ed = true;
-            else if (strcmp(tok, "eb") == 0) fr.eb = true;
-            else if (strcmp(tok, "es") == 0) fr.es = true;
-            else if (strcmp(tok, "scrub") == 0) fr.k = true;
+            if (strcmp(tok, "ed") == 0)
+                fr.ed = true;
+            else if (strcmp(tok, "eb") == 0)
+                fr.eb = true;
+            else if (strcmp(tok, "es") == 0)
+                fr.es = true;
+            else if (strcmp(tok, "scrub") == 0)
+                fr.k = true;
             else {
                 fprintf(stderr, "odo-calib fit: --free: unknown parameter '%s' (ed, eb, es, scrub)\n", tok);
                 return 2;
@@ -169,17 +144,33 @@ int calib_fit_main(int argc, char **argv)
             fprintf(stderr, "odo-calib fit: --out-params %s: name it .json or .bin\n", outs[k]);
             return 2;
         }
-        if (is_input(outs[k], robot, runs, n_runs)) {
-            fprintf(stderr, "odo-calib fit: --out-params %s is an input (the robot description or a file of "
-                            "a --runs folder)\n", outs[k]);
-            return 1;
+    }
+    /* Inputs never become outputs (hostlib/odo_out.h): the robot file, and anything inside a --runs folder. */
+    odo_out_inputs_t ins;
+    odo_out_inputs_init(&ins);
+    {
+        char ierr[256];
+        (void)odo_out_inputs_add(&ins, robot, ierr, sizeof ierr);
+        for (size_t k = 0; k < n_runs; ++k) {
+            if (odo_out_inputs_add(&ins, runs[k], ierr, sizeof ierr) != 0) {
+                fprintf(stderr, "odo-calib fit: %s\n", ierr);
+                return 2;
+            }
+        }
+        for (size_t k = 0; k < n_out; ++k) {
+            char oerr[PATH_MAX + 256];
+            if (odo_out_check_inputs(&ins, outs[k], oerr, sizeof oerr) != 0) {
+                fprintf(stderr, "odo-calib fit: --out-params %s\n", oerr);
+                return 1;
+            }
         }
     }
 
     char err[1024];
     static sim_robot_t rob;
     odo_params_t p0;
-    if (sim_robot_parse_file(robot, &rob, err, sizeof err) != 0 || sim_robot_to_params(&rob, &p0, err, sizeof err) != 0) {
+    if (sim_robot_parse_file(robot, &rob, err, sizeof err) != 0 ||
+        sim_robot_to_params(&rob, &p0, err, sizeof err) != 0) {
         fprintf(stderr, "odo-calib fit: %s\n", err);
         return 1;
     }
@@ -280,7 +271,7 @@ int calib_fit_main(int argc, char **argv)
     }
 
     for (size_t k = 0; k < n_out && rc == 0; ++k) {
-        if (calib_write_params(outs[k], &pb) != 0) {
+        if (calib_write_params(outs[k], &pb, &ins) != 0) {
             rc = 1;
         }
     }
@@ -290,8 +281,8 @@ int calib_fit_main(int argc, char **argv)
         json_str(stdout, robot);
         printf(",\n \"params\": {\"ed\": %.9f, \"eb\": %.9f, \"es\": %.9f, \"scrub\": %.9f},\n", res.p.ed, res.p.eb,
                res.p.es, res.p.k);
-        printf(" \"sd\": {\"ed\": %.3g, \"eb\": %.3g, \"es\": %.3g, \"scrub\": %.3g},\n", res.sd.ed, res.sd.eb, res.sd.es,
-               res.sd.k);
+        printf(" \"sd\": {\"ed\": %.3g, \"eb\": %.3g, \"es\": %.3g, \"scrub\": %.3g},\n", res.sd.ed, res.sd.eb,
+               res.sd.es, res.sd.k);
         printf(" \"fitted\": {\"ed\": %s, \"eb\": %s, \"es\": %s, \"scrub\": %s},\n", fr.ed ? "true" : "false",
                fr.eb ? "true" : "false", res.es_free ? "true" : "false", res.k_free ? "true" : "false");
         printf(" \"rms_mm\": %.4f, \"residuals\": %zu, \"iterations\": %d,\n \"rig\": {", res.rms_mm, res.n_residuals,
@@ -299,9 +290,8 @@ int calib_fit_main(int argc, char **argv)
         for (size_t g = 0; g < set.n_groups; ++g) {
             printf("%s", g ? ", " : "");
             json_str(stdout, set.group_name[g]);
-            printf(": {\"lever_arm_mm\": [%.3f, %.3f], \"heading_offset_deg\": %.4f, \"fitted\": %s}",
-                   res.rig[g].lx_mm, res.rig[g].ly_mm, res.rig[g].phi_rad * 180.0 / M_PI,
-                   res.rig[g].fitted ? "true" : "false");
+            printf(": {\"lever_arm_mm\": [%.3f, %.3f], \"heading_offset_deg\": %.4f, \"fitted\": %s}", res.rig[g].lx_mm,
+                   res.rig[g].ly_mm, res.rig[g].phi_rad * 180.0 / M_PI, res.rig[g].fitted ? "true" : "false");
         }
         printf("},\n \"runs\": [");
         for (size_t i = 0; i < set.n_runs; ++i) {
@@ -350,7 +340,8 @@ int calib_fit_main(int argc, char **argv)
         printf("  Ed    %.6f  (formal sd %.1e)%s\n", res.p.ed, res.sd.ed, fr.ed ? "" : "  fixed");
         printf("  Eb    %.6f  (formal sd %.1e)%s\n", res.p.eb, res.sd.eb, fr.eb ? "" : "  fixed");
         printf("  Es    %.6f  (formal sd %.1e)%s\n", res.p.es, res.sd.es,
-               res.es_free ? "" : (fr.es ? "  fixed: no fitted track (closed paths do not show the scale)" : "  fixed"));
+               res.es_free ? ""
+                           : (fr.es ? "  fixed: no fitted track (closed paths do not show the scale)" : "  fixed"));
         printf("  scrub %.6f  (formal sd %.1e)%s\n", res.p.k, res.sd.k, res.k_free ? "" : "  fixed");
         for (size_t g = 0; g < set.n_groups; ++g) {
             if (res.rig[g].fitted) {
@@ -383,7 +374,8 @@ int calib_fit_main(int argc, char **argv)
             }
         }
         printf("\nfirmware replaying the written block vs the double model of it, every tick of every run: "
-               "max %.2e mm (target <= 0.1 mm)\n", fw_max);
+               "max %.2e mm (target <= 0.1 mm)\n",
+               fw_max);
         if (set.can_fd_skipped) {
             printf("CAN FD lines skipped in the logs: %llu\n", (unsigned long long)set.can_fd_skipped);
         }

@@ -18,7 +18,8 @@
 #if defined(__GNUC__)
 __attribute__((format(printf, 3, 4)))
 #endif
-static int fail(char *err, size_t errlen, const char *fmt, ...)
+static int
+fail(char *err, size_t errlen, const char *fmt, ...)
 {
     va_list ap;
     va_start(ap, fmt);
@@ -32,12 +33,12 @@ static int fail(char *err, size_t errlen, const char *fmt, ...)
  * step accepts (odo_truck_step on a shadow truck with the app's own model).
  * ------------------------------------------------------------------------------------------- */
 typedef struct {
-    fit_run_t  *run;
-    size_t      cap;
+    fit_run_t *run;
+    size_t cap;
     odo_truck_t shadow;
-    int         oom;
-    int         have_seq;
-    uint8_t     last_seq;
+    int oom;
+    int have_seq;
+    uint8_t last_seq;
 } collect_t;
 
 static void on_tick(void *user, replay_t *r, uint64_t tick, const odo_tick_input_t *in, const odo_tick_output_t *out)
@@ -151,7 +152,8 @@ static int load_track(fit_run_t *run, const char *path, char *err, size_t errlen
         for (int k = 0; k < 4 && rc == 0; ++k) {
             errno = 0;
             v[k] = strtod(s, &e);
-            if (e == s || errno != 0 || !isfinite(v[k]) || (*e != ',' && !(k == 3 && (*e == '\n' || *e == '\r' || *e == '\0')))) {
+            if (e == s || errno != 0 || !isfinite(v[k]) ||
+                (*e != ',' && !(k == 3 && (*e == '\n' || *e == '\r' || *e == '\0')))) {
                 rc = fail(err, errlen, "%s:%u: field %d is not a finite number", path, ln, k + 1);
             }
             s = e + 1;
@@ -186,8 +188,8 @@ static int load_track(fit_run_t *run, const char *path, char *err, size_t errlen
         if (a[0] > run->t_s[0] + 0.5 * tick || a[4 * (n - 1)] < t_end - 0.5 * tick) {
             rc = fail(err, errlen,
                       "%s: the truth track covers %.3f-%.3f s but the log %s has %zu ticks over %.3f-%.3f s "
-                      "(mismatched ticks/truth lengths)", path, a[0], a[4 * (n - 1)], run->log_path, run->n,
-                      run->t_s[0], t_end);
+                      "(mismatched ticks/truth lengths)",
+                      path, a[0], a[4 * (n - 1)], run->log_path, run->n, run->t_s[0], t_end);
         }
     }
     if (rc == 0) {
@@ -204,8 +206,14 @@ static int load_track(fit_run_t *run, const char *path, char *err, size_t errlen
         for (size_t i = 0; i < n; ++i) {
             double th = a[4 * i + 3] * M_PI / 180.0 + off;
             if (i > 0) {
-                while (th - prev > M_PI) { th -= 2 * M_PI; off -= 2 * M_PI; }
-                while (th - prev < -M_PI) { th += 2 * M_PI; off += 2 * M_PI; }
+                while (th - prev > M_PI) {
+                    th -= 2 * M_PI;
+                    off -= 2 * M_PI;
+                }
+                while (th - prev < -M_PI) {
+                    th += 2 * M_PI;
+                    off += 2 * M_PI;
+                }
             }
             a[4 * i + 3] = prev = th;
         }
@@ -288,13 +296,20 @@ static int check_robot(const char *dir, const char *robot_path, const odo_params
     }
     const odo_truck_params_t *a = &p->truck[0], *b = &q.truck[0];
     const char *what = NULL;
-    if (a->wheel_diameter_nm != b->wheel_diameter_nm) what = "wheel_diameter_mm";
-    else if (a->wheelbase_nm != b->wheelbase_nm) what = "wheelbase_mm";
-    else if (a->counts_per_rev_milli != b->counts_per_rev_milli) what = "encoder_lines/gear_ratio";
-    else if (a->flags != b->flags) what = "invert_left/invert_right";
-    else if (p->counter_bits != q.counter_bits) what = "counter_bits";
-    else if (p->tick_us != q.tick_us) what = "tick_ms";
-    else if (p->vehicle != q.vehicle) what = "vehicle";
+    if (a->wheel_diameter_nm != b->wheel_diameter_nm)
+        what = "wheel_diameter_mm";
+    else if (a->wheelbase_nm != b->wheelbase_nm)
+        what = "wheelbase_mm";
+    else if (a->counts_per_rev_milli != b->counts_per_rev_milli)
+        what = "encoder_lines/gear_ratio";
+    else if (a->flags != b->flags)
+        what = "invert_left/invert_right";
+    else if (p->counter_bits != q.counter_bits)
+        what = "counter_bits";
+    else if (p->tick_us != q.tick_us)
+        what = "tick_ms";
+    else if (p->vehicle != q.vehicle)
+        what = "vehicle";
     if (what != NULL) {
         return fail(err, errlen, "%s: runs of a different robot: %s differs from %s", path, what, robot_path);
     }
@@ -425,7 +440,7 @@ int fit_data_select(fit_set_t *s, const char *const *fit, size_t n_fit, const ch
 
 typedef struct {
     double *x, *y;
-    size_t  n, cap;
+    size_t n, cap;
 } poses_t;
 
 static void on_pose(void *user, replay_t *r, uint64_t tick, const odo_tick_input_t *in, const odo_tick_output_t *out)

@@ -27,27 +27,27 @@
 #define FIT_MAX_GROUPS 32U
 
 typedef struct {
-    char     name[192];      ///< "<group>/<log stem>"
-    char     log_path[4096];
-    unsigned group;          ///< index into fit_set_t.group_name
-    size_t   n;              ///< ticks (tick 0 sets the counter baseline)
-    double  *t_s;            ///< tick times from the log's first frame
-    int32_t (*delta)[2];     ///< accepted count deltas per tick, forward positive, [left, right];
-                             ///< delta[0] = 0
-    bool     has_track;      ///< truth track, interpolated to the tick times:
-    double  *tx_mm, *ty_mm, *tth_rad; ///< tracked point (x, y) and heading (unwrapped)
-    bool     has_return;     ///< return pose from returns.csv (used when there is no track)
-    double   ret[3];         ///< x_mm, y_mm, theta_rad of the end pose in the start frame
-    bool     fit, judge;     ///< selected by --fit / --judge
+    char name[192]; ///< "<group>/<log stem>"
+    char log_path[4096];
+    unsigned group;                  ///< index into fit_set_t.group_name
+    size_t n;                        ///< ticks (tick 0 sets the counter baseline)
+    double *t_s;                     ///< tick times from the log's first frame
+    int32_t (*delta)[2];             ///< accepted count deltas per tick, forward positive, [left, right];
+                                     ///< delta[0] = 0
+    bool has_track;                  ///< truth track, interpolated to the tick times:
+    double *tx_mm, *ty_mm, *tth_rad; ///< tracked point (x, y) and heading (unwrapped)
+    bool has_return;                 ///< return pose from returns.csv (used when there is no track)
+    double ret[3];                   ///< x_mm, y_mm, theta_rad of the end pose in the start frame
+    bool fit, judge;                 ///< selected by --fit / --judge
 } fit_run_t;
 
 typedef struct {
-    size_t    n_runs;
+    size_t n_runs;
     fit_run_t run[FIT_MAX_RUNS];
-    size_t    n_groups;
-    char      group_name[FIT_MAX_GROUPS][96];
-    char      group_dir[FIT_MAX_GROUPS][4096];
-    uint64_t  can_fd_skipped; ///< CAN FD lines the log reader counted and skipped
+    size_t n_groups;
+    char group_name[FIT_MAX_GROUPS][96];
+    char group_dir[FIT_MAX_GROUPS][4096];
+    uint64_t can_fd_skipped; ///< CAN FD lines the log reader counted and skipped
 } fit_set_t;
 
 /// Read every run of `dir` (a folder odo-import wrote) into `s`, replaying the logs with the

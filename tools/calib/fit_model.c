@@ -43,9 +43,12 @@ void fit_integrate(const fit_run_t *run, const odo_truck_params_t *base, unsigne
         if (i > 0) {
             odo_ref_step(&r, run->delta[i][0], run->delta[i][1]);
         }
-        if (x != NULL) x[i] = r.x_mm;
-        if (y != NULL) y[i] = r.y_mm;
-        if (th != NULL) th[i] = r.theta_rad;
+        if (x != NULL)
+            x[i] = r.x_mm;
+        if (y != NULL)
+            y[i] = r.y_mm;
+        if (th != NULL)
+            th[i] = r.theta_rad;
     }
 }
 
@@ -54,24 +57,28 @@ void fit_integrate(const fit_run_t *run, const odo_truck_params_t *base, unsigne
  * folder with a fitted track lx, ly (mm), phi (mrad).
  * ------------------------------------------------------------------------------------------- */
 typedef struct {
-    const fit_set_t          *s;
+    const fit_set_t *s;
     const odo_truck_params_t *base;
-    unsigned                  form;
-    fit_params_t              start;
-    fit_free_t                fr;
-    int                       rig_slot[FIT_MAX_GROUPS]; /* index of lx in x, or -1 */
-    size_t                    np;
-    double                   *bx, *by, *bth;           /* scratch, longest run */
+    unsigned form;
+    fit_params_t start;
+    fit_free_t fr;
+    int rig_slot[FIT_MAX_GROUPS]; /* index of lx in x, or -1 */
+    size_t np;
+    double *bx, *by, *bth; /* scratch, longest run */
 } ctx_t;
 
 static void unpack(const ctx_t *c, const gsl_vector *v, fit_params_t *p, fit_rig_t *rig)
 {
     size_t j = 0;
     *p = c->start;
-    if (c->fr.ed) p->ed = 1.0 + gsl_vector_get(v, j++) * 1e-3;
-    if (c->fr.eb) p->eb = 1.0 + gsl_vector_get(v, j++) * 1e-3;
-    if (c->fr.es) p->es = 1.0 + gsl_vector_get(v, j++) * 1e-3;
-    if (c->fr.k) p->k = gsl_vector_get(v, j++) * 1e-3;
+    if (c->fr.ed)
+        p->ed = 1.0 + gsl_vector_get(v, j++) * 1e-3;
+    if (c->fr.eb)
+        p->eb = 1.0 + gsl_vector_get(v, j++) * 1e-3;
+    if (c->fr.es)
+        p->es = 1.0 + gsl_vector_get(v, j++) * 1e-3;
+    if (c->fr.k)
+        p->k = gsl_vector_get(v, j++) * 1e-3;
     for (size_t g = 0; g < FIT_MAX_GROUPS; ++g) {
         memset(&rig[g], 0, sizeof rig[g]);
         if (c->rig_slot[g] >= 0) {
@@ -182,7 +189,8 @@ void fit_return_error(const fit_run_t *run, const odo_truck_params_t *base, unsi
 #if defined(__GNUC__)
 __attribute__((format(printf, 3, 4)))
 #endif
-static int fail(char *err, size_t errlen, const char *fmt, ...)
+static int
+fail(char *err, size_t errlen, const char *fmt, ...)
 {
     va_list ap;
     va_start(ap, fmt);
@@ -229,10 +237,14 @@ int fit_run_fit(const fit_set_t *s, const odo_truck_params_t *base, unsigned hea
     gsl_vector *x = gsl_vector_calloc(c.np);
     {
         size_t j = 0;
-        if (c.fr.ed) gsl_vector_set(x, j++, (start->ed - 1.0) * 1e3);
-        if (c.fr.eb) gsl_vector_set(x, j++, (start->eb - 1.0) * 1e3);
-        if (c.fr.es) gsl_vector_set(x, j++, (start->es - 1.0) * 1e3);
-        if (c.fr.k) gsl_vector_set(x, j++, start->k * 1e3);
+        if (c.fr.ed)
+            gsl_vector_set(x, j++, (start->ed - 1.0) * 1e3);
+        if (c.fr.eb)
+            gsl_vector_set(x, j++, (start->eb - 1.0) * 1e3);
+        if (c.fr.es)
+            gsl_vector_set(x, j++, (start->es - 1.0) * 1e3);
+        if (c.fr.k)
+            gsl_vector_set(x, j++, start->k * 1e3);
     }
     gsl_multifit_nlinear_fdf fdf = {0};
     fdf.f = residuals;
@@ -266,19 +278,32 @@ int fit_run_fit(const fit_set_t *s, const odo_truck_params_t *base, unsigned hea
         if (cov != NULL && gsl_multifit_nlinear_covar(gsl_multifit_nlinear_jac(w), 0.0, cov) == GSL_SUCCESS) {
             const double sc = nr > c.np ? chisq / (double)(nr - c.np) : 0.0;
             size_t j = 0;
-            if (c.fr.ed) { out->sd.ed = sqrt(gsl_matrix_get(cov, j, j) * sc) * 1e-3; j++; }
-            if (c.fr.eb) { out->sd.eb = sqrt(gsl_matrix_get(cov, j, j) * sc) * 1e-3; j++; }
-            if (c.fr.es) { out->sd.es = sqrt(gsl_matrix_get(cov, j, j) * sc) * 1e-3; j++; }
-            if (c.fr.k) { out->sd.k = sqrt(gsl_matrix_get(cov, j, j) * sc) * 1e-3; j++; }
+            if (c.fr.ed) {
+                out->sd.ed = sqrt(gsl_matrix_get(cov, j, j) * sc) * 1e-3;
+                j++;
+            }
+            if (c.fr.eb) {
+                out->sd.eb = sqrt(gsl_matrix_get(cov, j, j) * sc) * 1e-3;
+                j++;
+            }
+            if (c.fr.es) {
+                out->sd.es = sqrt(gsl_matrix_get(cov, j, j) * sc) * 1e-3;
+                j++;
+            }
+            if (c.fr.k) {
+                out->sd.k = sqrt(gsl_matrix_get(cov, j, j) * sc) * 1e-3;
+                j++;
+            }
         }
         gsl_matrix_free(cov);
         if (!out->converged) {
             rc = fail(err, errlen, "the fit did not converge in %d iterations", out->iterations);
         } else if (fabs(out->p.k) > FIT_SCRUB_MAX || fabs(out->p.ed - 1.0) > 0.2 || fabs(out->p.eb - 1.0) > 0.2 ||
                    fabs(out->p.es - 1.0) > 0.2) {
-            rc = fail(err, errlen, "fitted parameters out of the block's range (Ed %.5f, Eb %.5f, Es %.5f, scrub %.5f): "
-                      "runs of another robot, or a wrong robot description?", out->p.ed, out->p.eb, out->p.es,
-                      out->p.k);
+            rc = fail(err, errlen,
+                      "fitted parameters out of the block's range (Ed %.5f, Eb %.5f, Es %.5f, scrub %.5f): "
+                      "runs of another robot, or a wrong robot description?",
+                      out->p.ed, out->p.eb, out->p.es, out->p.k);
         }
     }
     gsl_set_error_handler(old);

@@ -44,7 +44,7 @@ typedef struct {
 typedef struct {
     double lx_mm, ly_mm; ///< tracked point in the robot frame, from the axle centre
     double phi_rad;      ///< truth heading minus robot heading
-    bool   fitted;       ///< false: the folder had no fitted track (zeros used)
+    bool fitted;         ///< false: the folder had no fitted track (zeros used)
 } fit_rig_t;
 
 /// Which parameters are free (the rest keep the starting block's values).
@@ -53,15 +53,15 @@ typedef struct {
 } fit_free_t;
 
 typedef struct {
-    fit_params_t p;                     ///< fitted model
-    fit_params_t sd;                    ///< formal standard errors (residuals scaled; optimistic:
-                                        ///< track residuals are correlated along time)
-    fit_rig_t    rig[FIT_MAX_GROUPS];
-    double       rms_mm;                ///< RMS of the fitted residuals
-    size_t       n_residuals;
-    int          iterations;
-    bool         converged;
-    bool         es_free, k_free;       ///< as actually fitted (Es needs a track)
+    fit_params_t p;  ///< fitted model
+    fit_params_t sd; ///< formal standard errors (residuals scaled; optimistic:
+                     ///< track residuals are correlated along time)
+    fit_rig_t rig[FIT_MAX_GROUPS];
+    double rms_mm; ///< RMS of the fitted residuals
+    size_t n_residuals;
+    int iterations;
+    bool converged;
+    bool es_free, k_free; ///< as actually fitted (Es needs a track)
 } fit_result_t;
 
 /// One run's return error (000 Eq. 3.1 sign: computed minus true; axle centre, start frame).

@@ -24,29 +24,30 @@
 #include <stdint.h>
 
 #include "odo/odo_params.h"
+#include "odo_out.h"
 
 typedef enum { IMG_BIN = 0, IMG_HEX = 1, IMG_ELF = 2 } img_format_t;
 
 typedef struct {
-    size_t   line_start;  ///< offset of the record's ':' in the file
-    uint64_t addr;        ///< absolute address of its first data byte
+    size_t line_start; ///< offset of the record's ':' in the file
+    uint64_t addr;     ///< absolute address of its first data byte
     unsigned len;
 } img_hex_rec_t;
 
 typedef struct {
-    img_format_t   fmt;
-    uint8_t       *file;       ///< the file's bytes
-    size_t         file_len;
-    uint64_t       block_addr; ///< ELF/HEX: address; BIN: file offset
-    size_t         block_file_off; ///< BIN/ELF: file offset of the block
-    uint8_t        block[ODO_PARAMS_SIZE]; ///< the block found: block_len bytes, zeros after
-    size_t         block_len;  ///< its declared size: ODO_PARAMS_V1_SIZE or ODO_PARAMS_SIZE
-    unsigned       version;    ///< its layout version (1 or 2)
-    odo_params_status_t status; ///< odo_params_decode of the block found
-    unsigned       mode;       ///< the file's permission bits
+    img_format_t fmt;
+    uint8_t *file; ///< the file's bytes
+    size_t file_len;
+    uint64_t block_addr;            ///< ELF/HEX: address; BIN: file offset
+    size_t block_file_off;          ///< BIN/ELF: file offset of the block
+    uint8_t block[ODO_PARAMS_SIZE]; ///< the block found: block_len bytes, zeros after
+    size_t block_len;               ///< its declared size: ODO_PARAMS_V1_SIZE or ODO_PARAMS_SIZE
+    unsigned version;               ///< its layout version (1 or 2)
+    odo_params_status_t status;     ///< odo_params_decode of the block found
+    unsigned mode;                  ///< the file's permission bits
     /* HEX only */
     img_hex_rec_t *rec;
-    size_t         n_rec;
+    size_t n_rec;
 } img_t;
 
 /// Read and locate the block. Returns 0 with *img filled (img->status says whether the block
@@ -61,10 +62,11 @@ const char *img_format_name(img_format_t f);
 
 /// Write the image with `block` (a current-version block, ODO_PARAMS_SIZE bytes) in place of the
 /// old one to `out_path`: a temporary file in the same directory, flushed, read back and checked,
-/// then renamed over out_path (keeping the source file's permission bits). Refused (-1) when the
-/// image holds a block of another size (a version-1 image). On any error nothing but the old
-/// state remains. Returns 0, or -1.
-int img_write_patched(const img_t *img, const uint8_t block[ODO_PARAMS_SIZE], const char *out_path, char *err,
-                      size_t errlen);
+/// then renamed over out_path (keeping the source file's permission bits), by hostlib/odo_out.h's
+/// rule: out_path must be absent or a regular file, and neither one of `ins` (may be NULL) nor
+/// inside an input folder. Refused (-1) when the image holds a block of another size (a version-1
+/// image). On any error nothing but the old state remains. Returns 0, or -1.
+int img_write_patched(const img_t *img, const uint8_t block[ODO_PARAMS_SIZE], const char *out_path,
+                      const odo_out_inputs_t *ins, char *err, size_t errlen);
 
 #endif

@@ -7,6 +7,7 @@
 /// destination keeps its old content.
 #include <errno.h>
 #include <fcntl.h>
+#include <getopt.h>
 #include <inttypes.h>
 #include <math.h>
 #include <stdio.h>
@@ -19,6 +20,8 @@
 #include "calib_core.h"
 #include "fit_cli.h"
 #include "image.h"
+#include "odo_cli.h"
+#include "odo_out.h"
 #include "params_diag.h"
 #include "params_json.h"
 #include "returns_csv.h"
@@ -33,29 +36,29 @@ static const char *const k_prog = "odo-calib";
 
 static void usage(FILE *f)
 {
-    fprintf(f,
-            "usage: odo-calib <command> [options]      (odo-calib <command> --help for details)\n"
-            "\n"
-            "  umbmark --returns returns.csv --side-mm 4000 (--robot R.json | --params P.json|P.bin)\n"
-            "          [--robot R.json --params P] [--method paper|exact] [--json] [--out-params P.json|P.bin]\n"
-            "      UMBmark calibration (000 s. 6) of truck A from the return errors (000 Eq. 3.1);\n"
-            "      --params: the block the robot ran the test with (default: from --robot).\n"
-            "  write --image FW --params P.json|P.bin [--out OUT] [--force]\n"
-            "      put the parameter block into a firmware image (raw .bin, Intel HEX or ELF\n"
-            "      .odo_params); CRC recomputed; in place unless --out.\n"
-            "  read --image FW [--json]     print the image's parameter block (version 1 or 2)\n"
-            "  verify --image FW            check the image's block (layout, version, CRC, ranges)\n"
-            "  export --params P.json|P.bin --format ros2 [--controller-name NAME]\n"
-            "      diff_drive_controller parameters (YAML): absolute values and multipliers\n"
-            "  fit --runs DIR... --robot R.json [--fit GLOB...] [--judge GLOB...] [--out-params P]... [--json]\n"
-            "      calibrate Ed, Eb, Es and the turn-radius-dependent wheelbase from runs on any path\n"
-            "      with a truth track or return poses (odo-import folders); held-out before/after.\n"
-            "  acceptance [--robots N] [--seed S] [--runs N] [--json] [--no-tape] [--quiet]\n"
-            "      simulated labmates (Ed ~ U[0.995, 1.005], b ~ U[0.97, 1.03] x 340 mm, floor\n"
-            "      roughness): Emax,syst before/after one pass, exact and paper methods; E-7/E-8\n"
-            "      tape analogues; noise-free recovery. Prints a 000 Table III-like table.\n"
-            "\n"
-            "Exit status: 0 ok, 1 rejected input or I/O error, 2 usage error.\n");
+    fprintf(f, "usage: odo-calib <command> [options]      (odo-calib <command> --help for details)\n"
+               "       odo-calib --help | --version\n"
+               "\n"
+               "  umbmark --returns returns.csv --side-mm 4000 (--robot R.json | --params P.json|P.bin)\n"
+               "          [--robot R.json --params P] [--method paper|exact] [--json] [--out-params P.json|P.bin]\n"
+               "      UMBmark calibration (000 s. 6) of truck A from the return errors (000 Eq. 3.1);\n"
+               "      --params: the block the robot ran the test with (default: from --robot).\n"
+               "  write --image FW --params P.json|P.bin [--out OUT] [--force]\n"
+               "      put the parameter block into a firmware image (raw .bin, Intel HEX or ELF\n"
+               "      .odo_params); CRC recomputed; in place unless --out.\n"
+               "  read --image FW [--json]     print the image's parameter block (version 1 or 2)\n"
+               "  verify --image FW            check the image's block (layout, version, CRC, ranges)\n"
+               "  export --params P.json|P.bin --format ros2 [--controller-name NAME]\n"
+               "      diff_drive_controller parameters (YAML): absolute values and multipliers\n"
+               "  fit --runs DIR... --robot R.json [--fit GLOB...] [--judge GLOB...] [--out-params P]... [--json]\n"
+               "      calibrate Ed, Eb, Es and the turn-radius-dependent wheelbase from runs on any path\n"
+               "      with a truth track or return poses (odo-import folders); held-out before/after.\n"
+               "  acceptance [--robots N] [--seed S] [--runs N] [--json] [--no-tape] [--quiet]\n"
+               "      simulated labmates (Ed ~ U[0.995, 1.005], b ~ U[0.97, 1.03] x 340 mm, floor\n"
+               "      roughness): Emax,syst before/after one pass, exact and paper methods; E-7/E-8\n"
+               "      tape analogues; noise-free recovery. Prints a 000 Table III-like table.\n"
+               "\n"
+               "Exit status: 0 ok, 1 rejected input or I/O error, 2 usage error.\n");
 }
 
 static int is_help(const char *a) { return strcmp(a, "-h") == 0 || strcmp(a, "--help") == 0; }
@@ -63,30 +66,38 @@ static int is_help(const char *a) { return strcmp(a, "-h") == 0 || strcmp(a, "--
 /// Options as name/value pairs; flags have value "1".
 typedef struct {
     const char *name;
-    int         takes_value;
+    int takes_value;
     const char *value;
 } opt_t;
 
+/// getopt_long over the table (so --name=value works too); argv[-1] is the command's name.
 static int parse_opts(const char *cmd, int argc, char **argv, opt_t *o, size_t n)
 {
-    for (int i = 0; i < argc; ++i) {
-        size_t k = 0;
-        while (k < n && strcmp(argv[i], o[k].name) != 0) {
-            k++;
-        }
-        if (k == n) {
-            fprintf(stderr, "%s %s: unknown argument '%s' (see %s %s --help)\n", k_prog, cmd, argv[i], k_prog, cmd);
+    struct option lo[16];
+    if (n >= sizeof lo / sizeof lo[0]) {
+        return -1;
+    }
+    for (size_t k = 0; k < n; ++k) {
+        lo[k].name = o[k].name + 2; /* "--image" -> "image" */
+        lo[k].has_arg = o[k].takes_value ? required_argument : no_argument;
+        lo[k].flag = NULL;
+        lo[k].val = (int)k;
+    }
+    memset(&lo[n], 0, sizeof lo[n]);
+    optind = 1;
+    opterr = 0;
+    for (int c; (c = getopt_long(argc + 1, argv - 1, ":", lo, NULL)) != -1;) {
+        if (c == '?' || c == ':') {
+            fprintf(stderr, "%s %s: %s '%s' (see %s %s --help)\n", k_prog, cmd,
+                    c == ':' ? "missing value for" : "unknown argument", argv[optind - 2], k_prog, cmd);
             return -1;
         }
-        if (o[k].takes_value) {
-            if (i + 1 >= argc) {
-                fprintf(stderr, "%s %s: %s needs a value\n", k_prog, cmd, argv[i]);
-                return -1;
-            }
-            o[k].value = argv[++i];
-        } else {
-            o[k].value = "1";
-        }
+        o[c].value = o[c].takes_value ? optarg : "1";
+    }
+    if (optind < argc + 1) {
+        fprintf(stderr, "%s %s: unexpected argument '%s' (see %s %s --help)\n", k_prog, cmd, argv[optind - 1], k_prog,
+                cmd);
+        return -1;
     }
     return 0;
 }
@@ -107,50 +118,24 @@ static int ends_with(const char *s, const char *suf)
     return a >= b && strcmp(s + a - b, suf) == 0;
 }
 
-/// Write a text or binary output atomically: path.tmp.<pid>, fsync, rename.
-static int write_atomic(const char *path, const void *data, size_t len)
+/// Write an output by hostlib/odo_out.h's rule (temp beside it, fsync, rename; never an input).
+static int write_atomic(const char *path, const void *data, size_t len, const odo_out_inputs_t *ins)
 {
-    char tmp[4096];
-    if (snprintf(tmp, sizeof tmp, "%s.tmp.%ld", path, (long)getpid()) >= (int)sizeof tmp) {
-        fprintf(stderr, "%s: output path too long\n", k_prog);
-        return -1;
-    }
-    const int fd = open(tmp, O_WRONLY | O_CREAT | O_EXCL, 0644);
-    if (fd < 0) {
-        fprintf(stderr, "%s: cannot create %s: %s\n", k_prog, tmp, strerror(errno));
-        return -1;
-    }
-    const uint8_t *p = data;
-    size_t left = len;
-    while (left > 0) {
-        const ssize_t w = write(fd, p, left);
-        if (w < 0 && errno == EINTR) {
-            continue;
-        }
-        if (w <= 0) {
-            fprintf(stderr, "%s: cannot write %s: %s\n", k_prog, tmp, strerror(errno));
-            close(fd);
-            unlink(tmp);
-            return -1;
-        }
-        p += w;
-        left -= (size_t)w;
-    }
-    if (fsync(fd) != 0 || close(fd) != 0 || rename(tmp, path) != 0) {
-        fprintf(stderr, "%s: cannot write %s: %s\n", k_prog, path, strerror(errno));
-        unlink(tmp);
+    char err[PATH_MAX + 256];
+    if (odo_out_write(path, data, len, ins, err, sizeof err) != 0) {
+        fprintf(stderr, "%s: %s\n", k_prog, err);
         return -1;
     }
     return 0;
 }
 
 /// Parameters as JSON text (malloc'd) or as the 128-byte block, by the output's extension.
-int calib_write_params(const char *path, const odo_params_t *p)
+int calib_write_params(const char *path, const odo_params_t *p, const odo_out_inputs_t *ins)
 {
     if (ends_with(path, ".bin")) {
         uint8_t block[ODO_PARAMS_SIZE];
         (void)odo_params_encode(p, block, sizeof block);
-        return write_atomic(path, block, sizeof block);
+        return write_atomic(path, block, sizeof block, ins);
     }
     char *buf = NULL;
     size_t len = 0;
@@ -160,7 +145,7 @@ int calib_write_params(const char *path, const odo_params_t *p)
         fprintf(stderr, "%s: out of memory\n", k_prog);
         return -1;
     }
-    const int rc = write_atomic(path, buf, len);
+    const int rc = write_atomic(path, buf, len, ins);
     free(buf);
     return rc;
 }
@@ -174,36 +159,43 @@ static void print_calib_json(FILE *f, const calib_result_t *c, const char *retur
 {
     const odo_umb_stats_t *s = &c->st;
     const odo_umb_calib_t *p = &c->paper;
-    fprintf(f, "{\"method\": \"%s\", \"returns\": \"%s\", \"side_mm\": %.3f,\n", c->method == CALIB_EXACT ? "exact" : "paper",
-            returns_path, side_mm);
+    fprintf(f, "{\"method\": \"%s\", \"returns\": \"%s\", \"side_mm\": %.3f,\n",
+            c->method == CALIB_EXACT ? "exact" : "paper", returns_path, side_mm);
     fprintf(f, " \"Ed\": %.9f, \"Eb\": %.9f, \"cL\": %.9f, \"cR\": %.9f, \"b_actual_mm\": %.4f,\n", c->ed_q30 / Q30,
             c->eb_q30 / Q30, c->cl_q30 / Q30, c->cr_q30 / Q30, c->b_actual_mm);
     fprintf(f, " \"ed_q30\": %" PRId32 ", \"eb_q30\": %" PRId32 ", \"ed_in_force\": %.9f, \"eb_in_force\": %.9f,\n",
             c->ed_q30, c->eb_q30, c->ed_in_force, c->eb_in_force);
-    fprintf(f, " \"alpha_deg\": %.6f, \"beta_deg\": %.6f, \"alpha_x_deg\": %.6f, \"alpha_y_deg\": %.6f, "
-               "\"beta_x_deg\": %.6f, \"beta_y_deg\": %.6f,\n \"alpha_disagree_deg\": %.6f, \"beta_disagree_deg\": %.6f, "
-               "\"radius_mm\": %.1f,\n",
+    fprintf(f,
+            " \"alpha_deg\": %.6f, \"beta_deg\": %.6f, \"alpha_x_deg\": %.6f, \"alpha_y_deg\": %.6f, "
+            "\"beta_x_deg\": %.6f, \"beta_y_deg\": %.6f,\n \"alpha_disagree_deg\": %.6f, \"beta_disagree_deg\": %.6f, "
+            "\"radius_mm\": %.1f,\n",
             p->alpha_bam * BAM_DEG, p->beta_bam * BAM_DEG, p->alpha_x_bam * BAM_DEG, p->alpha_y_bam * BAM_DEG,
             p->beta_x_bam * BAM_DEG, p->beta_y_bam * BAM_DEG, p->alpha_disagree_bam * BAM_DEG,
-            p->beta_disagree_bam * BAM_DEG, p->radius_um / 1000.0);
-    fprintf(f, " \"runs_cw\": %u, \"runs_ccw\": %u, \"cg_cw_mm\": [%.3f, %.3f], \"cg_ccw_mm\": [%.3f, %.3f], "
-               "\"r_cg_cw_mm\": %.3f, \"r_cg_ccw_mm\": %.3f,\n",
+            p->beta_disagree_bam * BAM_DEG, (double)p->radius_um / 1000.0);
+    fprintf(f,
+            " \"runs_cw\": %u, \"runs_ccw\": %u, \"cg_cw_mm\": [%.3f, %.3f], \"cg_ccw_mm\": [%.3f, %.3f], "
+            "\"r_cg_cw_mm\": %.3f, \"r_cg_ccw_mm\": %.3f,\n",
             s->n[0], s->n[1], s->cg_x_um[0] / 1000.0, s->cg_y_um[0] / 1000.0, s->cg_x_um[1] / 1000.0,
             s->cg_y_um[1] / 1000.0, s->r_cg_um[0] / 1000.0, s->r_cg_um[1] / 1000.0);
     fprintf(f, " \"emax_syst_mm\": %.3f, \"sigma_mm\": %.3f, \"sem_mm\": %.3f, \"second_pass_advised\": %s,\n",
-            s->emax_syst_um / 1000.0, s->sigma_um / 1000.0, s->sem_um / 1000.0, s->second_pass_advised ? "true" : "false");
+            s->emax_syst_um / 1000.0, s->sigma_um / 1000.0, s->sem_um / 1000.0,
+            s->second_pass_advised ? "true" : "false");
     fprintf(f, " \"theta_bias_cw_deg\": %.6f, \"theta_bias_ccw_deg\": %.6f, \"avg_abs_theta_deg\": %.6f,\n",
             s->theta_bias_udeg[0] / 1e6, s->theta_bias_udeg[1] / 1e6, s->avg_abs_theta_udeg / 1e6);
-    fprintf(f, " \"paper\": {\"Ed\": %.9f, \"Eb\": %.9f, \"b_actual_mm\": %.4f, \"ed_measured\": %.9f, \"eb_measured\": %.9f},\n",
-            p->ed_q30 / Q30, p->eb_q30 / Q30, p->b_actual_nm / 1e6, p->ed_meas_q30 / Q30, p->eb_meas_q30 / Q30);
+    fprintf(
+        f,
+        " \"paper\": {\"Ed\": %.9f, \"Eb\": %.9f, \"b_actual_mm\": %.4f, \"ed_measured\": %.9f, \"eb_measured\": %.9f},\n",
+        p->ed_q30 / Q30, p->eb_q30 / Q30, p->b_actual_nm / 1e6, p->ed_meas_q30 / Q30, p->eb_meas_q30 / Q30);
     if (c->method == CALIB_EXACT) {
-        fprintf(f, " \"exact\": {\"Ed\": %.9f, \"b_mm\": %.5f, \"residual_mm\": %.4f, \"iterations\": %d, "
-                   "\"converged\": %s, \"identifiable\": %s, \"singular_value_ratio\": %.3e},\n",
+        fprintf(f,
+                " \"exact\": {\"Ed\": %.9f, \"b_mm\": %.5f, \"residual_mm\": %.4f, \"iterations\": %d, "
+                "\"converged\": %s, \"identifiable\": %s, \"singular_value_ratio\": %.3e},\n",
                 c->fit.ed, c->fit.b_mm, c->fit.residual_mm, c->fit.iterations, c->fit.converged ? "true" : "false",
                 c->fit.identifiable ? "true" : "false", c->fit.sv_max > 0 ? c->fit.sv_min / c->fit.sv_max : 0.0);
     }
-    fprintf(f, " \"not_identifiable\": [\"es: a closed square does not show the scale error; measure it with a tape "
-               "(000 App. B)\", \"truck B: UMBmark returns are truck A's\"%s],\n",
+    fprintf(f,
+            " \"not_identifiable\": [\"es: a closed square does not show the scale error; measure it with a tape "
+            "(000 App. B)\", \"truck B: UMBmark returns are truck A's\"%s],\n",
             c->method == CALIB_EXACT && !c->fit.identifiable ? ", \"Ed and b: the data do not separate them\"" : "");
     fprintf(f, " \"out_params\": ");
     if (out_params != NULL) {
@@ -220,10 +212,11 @@ static void print_calib_table(FILE *f, const calib_result_t *c)
     fprintf(f, "UMBmark (000 s. 3): %u cw + %u ccw runs\n", s->n[0], s->n[1]);
     fprintf(f, "  cg cw  (%9.2f, %9.2f) mm   r %8.2f mm   (Eqs. 3.2, 3.3)\n", s->cg_x_um[0] / 1e3, s->cg_y_um[0] / 1e3,
             s->r_cg_um[0] / 1e3);
-    fprintf(f, "  cg ccw (%9.2f, %9.2f) mm   r %8.2f mm\n", s->cg_x_um[1] / 1e3, s->cg_y_um[1] / 1e3, s->r_cg_um[1] / 1e3);
+    fprintf(f, "  cg ccw (%9.2f, %9.2f) mm   r %8.2f mm\n", s->cg_x_um[1] / 1e3, s->cg_y_um[1] / 1e3,
+            s->r_cg_um[1] / 1e3);
     fprintf(f, "  Emax,syst %.2f mm (Eq. 3.4)   sigma %.2f mm   SEM %.2f mm   second pass %s (Emax,syst %s 3 SEM)\n",
-            s->emax_syst_um / 1e3, s->sigma_um / 1e3, s->sem_um / 1e3, s->second_pass_advised ? "advised" : "not needed",
-            s->second_pass_advised ? ">" : "<=");
+            s->emax_syst_um / 1e3, s->sigma_um / 1e3, s->sem_um / 1e3,
+            s->second_pass_advised ? "advised" : "not needed", s->second_pass_advised ? ">" : "<=");
     fprintf(f, "  alpha %.4f deg (x %.4f, y %.4f)   beta %.4f deg (x %.4f, y %.4f)   (Eqs. 6.22, 6.26)\n",
             p->alpha_bam * BAM_DEG, p->alpha_x_bam * BAM_DEG, p->alpha_y_bam * BAM_DEG, p->beta_bam * BAM_DEG,
             p->beta_x_bam * BAM_DEG, p->beta_y_bam * BAM_DEG);
@@ -260,8 +253,8 @@ static int params_in_force(const char *cmd, const char *robot_path, const char *
 
 static int cmd_umbmark(int argc, char **argv)
 {
-    opt_t o[] = {{"--returns", 1, NULL}, {"--side-mm", 1, NULL}, {"--robot", 1, NULL}, {"--params", 1, NULL},
-                 {"--method", 1, NULL}, {"--json", 0, NULL}, {"--out-params", 1, NULL}};
+    opt_t o[] = {{"--returns", 1, NULL}, {"--side-mm", 1, NULL}, {"--robot", 1, NULL},     {"--params", 1, NULL},
+                 {"--method", 1, NULL},  {"--json", 0, NULL},    {"--out-params", 1, NULL}};
     const size_t n = sizeof o / sizeof o[0];
     for (int i = 0; i < argc; ++i) {
         if (is_help(argv[i])) {
@@ -322,7 +315,12 @@ static int cmd_umbmark(int argc, char **argv)
     if (out != NULL) {
         odo_params_t np;
         calib_apply(&in_force, &c, &np);
-        if (calib_write_params(out, &np) != 0) {
+        odo_out_inputs_t ins; /* --out-params equal to --returns (or the robot, the block) is refused */
+        odo_out_inputs_init(&ins);
+        (void)odo_out_inputs_add(&ins, returns_path, err, sizeof err);
+        (void)odo_out_inputs_add(&ins, robot, err, sizeof err);
+        (void)odo_out_inputs_add(&ins, params, err, sizeof err);
+        if (calib_write_params(out, &np, &ins) != 0) {
             return EXIT_FAIL;
         }
     }
@@ -389,14 +387,21 @@ static int cmd_write(int argc, char **argv)
         return EXIT_FAIL;
     }
     if (img.status == ODO_PARAMS_ERR_CRC && opt(o, n, "--force") == NULL) {
-        fprintf(stderr, "%s write: %s: the block at 0x%llx has a bad CRC-32 (corrupted image?); --force to "
-                        "overwrite it anyway\n", k_prog, image, (unsigned long long)img.block_addr);
+        fprintf(stderr,
+                "%s write: %s: the block at 0x%llx has a bad CRC-32 (corrupted image?); --force to "
+                "overwrite it anyway\n",
+                k_prog, image, (unsigned long long)img.block_addr);
         img_free(&img);
         return EXIT_FAIL;
     }
     uint8_t block[ODO_PARAMS_SIZE];
     (void)odo_params_encode(&p, block, sizeof block);
-    const int rc = img_write_patched(&img, block, out != NULL ? out : image, err, sizeof err);
+    /* The block file is an input: --out equal to --params is refused. The image itself is the
+     * documented in-place default, so it is not. */
+    odo_out_inputs_t ins;
+    odo_out_inputs_init(&ins);
+    (void)odo_out_inputs_add(&ins, params, err, sizeof err);
+    const int rc = img_write_patched(&img, block, out != NULL ? out : image, &ins, err, sizeof err);
     if (rc != 0) {
         fprintf(stderr, "%s write: %s\n", k_prog, err);
     } else {
@@ -452,9 +457,10 @@ static uint32_t stored_crc(const img_t *img)
 
 static int cmd_read(int argc, char **argv)
 {
-    if (help_if(argc, argv, "usage: odo-calib read --image FW [--json]\n\nPrint the parameter block of a firmware "
-                            "image (.bin, Intel HEX, ELF), version 1 or 2; --json in the shape `odo-params show` "
-                            "prints (a version-1 block without scrub_q30).\n")) {
+    if (help_if(argc, argv,
+                "usage: odo-calib read --image FW [--json]\n\nPrint the parameter block of a firmware "
+                "image (.bin, Intel HEX, ELF), version 1 or 2; --json in the shape `odo-params show` "
+                "prints (a version-1 block without scrub_q30).\n")) {
         return 0;
     }
     img_t img;
@@ -478,14 +484,15 @@ static int cmd_read(int argc, char **argv)
             int32_t cl_q = 0, cr_q = 0;
             (void)odo_umb_correction_factors(t->ed_q30, &cl_q, &cr_q);
             printf("truck %c: Dn %.4f mm, b %.4f mm, counts/rev %.3f, Ed %.7f, Eb %.7f, Es %.7f, scrub k %.7f "
-                   "(cL %.7f, cR %.7f, b_actual %.4f mm on spot turns)\n", 'A' + k, t->wheel_diameter_nm / 1e6,
-                   t->wheelbase_nm / 1e6, t->counts_per_rev_milli / 1e3, t->ed_q30 / Q30, t->eb_q30 / Q30,
-                   t->es_q30 / Q30, t->scrub_q30 / Q30, cl_q / Q30, cr_q / Q30,
+                   "(cL %.7f, cR %.7f, b_actual %.4f mm on spot turns)\n",
+                   'A' + k, t->wheel_diameter_nm / 1e6, t->wheelbase_nm / 1e6, t->counts_per_rev_milli / 1e3,
+                   t->ed_q30 / Q30, t->eb_q30 / Q30, t->es_q30 / Q30, t->scrub_q30 / Q30, cl_q / Q30, cr_q / Q30,
                    t->wheelbase_nm / 1e6 * (t->eb_q30 / Q30));
         }
         if (img.version < ODO_PARAMS_VERSION) {
             printf("(a version-%u block: scrub_q30 reads as 0; `odo-calib write` refuses this image, whose firmware "
-                   "reads version %u only)\n", img.version, img.version);
+                   "reads version %u only)\n",
+                   img.version, img.version);
         }
     }
     img_free(&img);
@@ -494,10 +501,11 @@ static int cmd_read(int argc, char **argv)
 
 static int cmd_verify(int argc, char **argv)
 {
-    if (help_if(argc, argv, "usage: odo-calib verify --image FW\n\nCheck the parameter block of a firmware image as "
-                            "the firmware does at boot (magic, version 1 or 2, length, CRC-32, every range, reserved "
-                            "bytes zero). Exit 0 iff the firmware would accept it; otherwise the message names the "
-                            "offending field.\n")) {
+    if (help_if(argc, argv,
+                "usage: odo-calib verify --image FW\n\nCheck the parameter block of a firmware image as "
+                "the firmware does at boot (magic, version 1 or 2, length, CRC-32, every range, reserved "
+                "bytes zero). Exit 0 iff the firmware would accept it; otherwise the message names the "
+                "offending field.\n")) {
         return 0;
     }
     img_t img;
@@ -541,7 +549,8 @@ static int cmd_export(int argc, char **argv)
         return EXIT_USAGE;
     }
     const char *params = opt(o, n, "--params"), *format = opt(o, n, "--format");
-    const char *name = opt(o, n, "--controller-name") != NULL ? opt(o, n, "--controller-name") : "diff_drive_controller";
+    const char *name =
+        opt(o, n, "--controller-name") != NULL ? opt(o, n, "--controller-name") : "diff_drive_controller";
     if (params == NULL || format == NULL) {
         fprintf(stderr, "%s export: --params and --format are required\n", k_prog);
         return EXIT_USAGE;
@@ -556,8 +565,8 @@ static int cmd_export(int argc, char **argv)
         name_ok = (*c >= 'a' && *c <= 'z') || (*c >= 'A' && *c <= 'Z') || (*c >= '0' && *c <= '9') || *c == '_';
     }
     if (!name_ok) {
-        fprintf(stderr, "%s export: --controller-name '%s' is not a ROS 2 node name ([A-Za-z_][A-Za-z0-9_]*)\n",
-                k_prog, name);
+        fprintf(stderr, "%s export: --controller-name '%s' is not a ROS 2 node name ([A-Za-z_][A-Za-z0-9_]*)\n", k_prog,
+                name);
         return EXIT_USAGE;
     }
     odo_params_t p;
@@ -591,6 +600,13 @@ static int cmd_export(int argc, char **argv)
 
 int main(int argc, char **argv)
 {
+    if (!odo_cli_split_equals(&argc, &argv)) {
+        return EXIT_FAIL;
+    }
+    if (argc >= 2 && strcmp(argv[1], "--version") == 0) {
+        odo_cli_print_version(k_prog);
+        return 0;
+    }
     if (argc < 2 || is_help(argv[1])) {
         usage(argc < 2 ? stderr : stdout);
         return argc < 2 ? EXIT_USAGE : 0;

@@ -9,8 +9,8 @@
 #include <string.h>
 
 static const char k_header[] = "run,direction,x_abs_mm,y_abs_mm,theta_abs_deg,x_calc_mm,y_calc_mm,theta_calc_deg";
-static const char *const k_cols[] = {"run", "direction", "x_abs_mm", "y_abs_mm", "theta_abs_deg",
-                                     "x_calc_mm", "y_calc_mm", "theta_calc_deg"};
+static const char *const k_cols[] = {"run",           "direction", "x_abs_mm",  "y_abs_mm",
+                                     "theta_abs_deg", "x_calc_mm", "y_calc_mm", "theta_calc_deg"};
 
 static void chomp(char *s)
 {
@@ -53,7 +53,7 @@ int returns_read(const char *path, returns_t *r, char *err, size_t errlen)
         }
         char *field[9];
         size_t nf = 0;
-        for (char *p = line;; ) {
+        for (char *p = line;;) {
             if (nf < 9) {
                 field[nf] = p;
             }
@@ -84,8 +84,10 @@ int returns_read(const char *path, returns_t *r, char *err, size_t errlen)
         } else if (strcmp(field[1], "ccw") == 0) {
             d = 1;
         } else {
-            snprintf(err, errlen, "%s:%u: field 2 (direction): '%s' must be cw or ccw (UMBmark is a square "
-                                  "run both ways)", path, lineno, field[1]);
+            snprintf(err, errlen,
+                     "%s:%u: field 2 (direction): '%s' must be cw or ccw (UMBmark is a square "
+                     "run both ways)",
+                     path, lineno, field[1]);
             rc = -1;
             break;
         }
@@ -103,9 +105,8 @@ int returns_read(const char *path, returns_t *r, char *err, size_t errlen)
             } else if (fabs(v[k]) > lim) {
                 /* Beyond it the difference of two such values loses the resolution the
                  * calibration works in (1 um, 1 micro-degree); 1e308 deg came out as 0. */
-                snprintf(err, errlen, "%s:%u: field %d (%s): '%s' is beyond +-%.0e %s: not a %s", path, lineno,
-                         3 + k, k_cols[2 + k], field[2 + k], lim, angle ? "deg" : "mm",
-                         angle ? "heading" : "return position");
+                snprintf(err, errlen, "%s:%u: field %d (%s): '%s' is beyond +-%.0e %s: not a %s", path, lineno, 3 + k,
+                         k_cols[2 + k], field[2 + k], lim, angle ? "deg" : "mm", angle ? "heading" : "return position");
                 rc = -1;
             }
         }
@@ -141,9 +142,10 @@ int returns_to_umb(const returns_t *r, odo_umb_return_t out[2][RETURNS_MAX_RUNS]
         for (size_t i = 0; i < r->n[d]; ++i) {
             const double x = r->ex_mm[d][i] * 1000.0, y = r->ey_mm[d][i] * 1000.0;
             if (fabs(x) > ODO_UMB_MAX_ERR_UM || fabs(y) > ODO_UMB_MAX_ERR_UM) {
-                snprintf(err, errlen, "%s run %u: return error (%.1f, %.1f) mm is beyond the %.1f m the "
-                                      "calibration accepts", d ? "ccw" : "cw", r->run[d][i], r->ex_mm[d][i],
-                         r->ey_mm[d][i], ODO_UMB_MAX_ERR_UM / 1e6);
+                snprintf(err, errlen,
+                         "%s run %u: return error (%.1f, %.1f) mm is beyond the %.1f m the "
+                         "calibration accepts",
+                         d ? "ccw" : "cw", r->run[d][i], r->ex_mm[d][i], r->ey_mm[d][i], ODO_UMB_MAX_ERR_UM / 1e6);
                 return -1;
             }
             out[d][i].ex_um = (int32_t)lround(x);

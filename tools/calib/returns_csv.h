@@ -16,15 +16,15 @@
 
 #include "odo/odo_umbmark.h"
 
-#define RETURNS_MAX_RUNS ODO_UMB_MAX_RUNS
+#define RETURNS_MAX_RUNS    ODO_UMB_MAX_RUNS
 #define RETURNS_MAX_ABS_MM  1e9 ///< |x|, |y| (1000 km): doubles keep 1e-7 mm there
 #define RETURNS_MAX_ABS_DEG 1e6 ///< |theta| (2778 turns): doubles keep 1e-10 deg there
 
 typedef struct {
-    size_t n[2];                                  ///< cw, ccw
-    double ex_mm[2][RETURNS_MAX_RUNS];            ///< 000 Eq. 3.1: absolute - calculated
+    size_t n[2];                       ///< cw, ccw
+    double ex_mm[2][RETURNS_MAX_RUNS]; ///< 000 Eq. 3.1: absolute - calculated
     double ey_mm[2][RETURNS_MAX_RUNS];
-    double etheta_deg[2][RETURNS_MAX_RUNS];       ///< wrapped to [-180, 180]
+    double etheta_deg[2][RETURNS_MAX_RUNS]; ///< wrapped to [-180, 180]
     unsigned run[2][RETURNS_MAX_RUNS];
 } returns_t;
 

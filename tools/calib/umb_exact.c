@@ -47,8 +47,8 @@ static void residuals(const umb_setup_t *s, const double cg[2][2], double ed, do
 
 static double sumsq(const double r[4]) { return r[0] * r[0] + r[1] * r[1] + r[2] * r[2] + r[3] * r[3]; }
 
-int umb_exact_fit(const umb_setup_t *s, const double cg[2][2], double ed0, double b0_mm, umb_fit_t *out,
-                  char *err, unsigned errlen)
+int umb_exact_fit(const umb_setup_t *s, const double cg[2][2], double ed0, double b0_mm, umb_fit_t *out, char *err,
+                  unsigned errlen)
 {
     memset(out, 0, sizeof *out);
     if (!isfinite(ed0) || !isfinite(b0_mm) || ed0 <= 0.0 || b0_mm <= 0.0 || !(s->side_mm > 0.0) ||
@@ -110,8 +110,9 @@ int umb_exact_fit(const umb_setup_t *s, const double cg[2][2], double ed0, doubl
             }
         }
         if (!(p[0] >= 0.5 && p[0] <= 2.0 && p[1] >= 0.2 * s->b_nominal_mm && p[1] <= 5.0 * s->b_nominal_mm)) {
-            snprintf(err, errlen, "exact fit left the physical range (Ed %.6g, b %.6g mm): the return "
-                                  "errors are not those of a differential drive with Ed and b errors",
+            snprintf(err, errlen,
+                     "exact fit left the physical range (Ed %.6g, b %.6g mm): the return "
+                     "errors are not those of a differential drive with Ed and b errors",
                      p[0], p[1]);
             return -1;
         }

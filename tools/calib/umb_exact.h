@@ -37,16 +37,16 @@ typedef struct {
     double b_mm;           ///< fitted true effective wheelbase (block eb = b_mm / b_nominal)
     double residual_mm;    ///< rms misfit of the four cg coordinates at the solution
     double sv_min, sv_max; ///< singular values of the scaled Jacobian (identifiability)
-    bool   identifiable;   ///< sv_min / sv_max above 1e-9 and both singular values non-zero
-    bool   converged;
-    int    iterations;
+    bool identifiable;     ///< sv_min / sv_max above 1e-9 and both singular values non-zero
+    bool converged;
+    int iterations;
 } umb_fit_t;
 
 /// Levenberg-Marquardt fit of (Ed, b) to cg[dir][x, y] (dir 0 cw, 1 ccw; mm), starting at
 /// (ed0, b0_mm) (the paper method's answer). Returns 0, or -1 (message in err) if the start is not
 /// finite or positive or the fit leaves the physical range (Ed in [0.5, 2], b in [0.2, 5] x
 /// nominal).
-int umb_exact_fit(const umb_setup_t *s, const double cg[2][2], double ed0, double b0_mm, umb_fit_t *out,
-                  char *err, unsigned errlen);
+int umb_exact_fit(const umb_setup_t *s, const double cg[2][2], double ed0, double b0_mm, umb_fit_t *out, char *err,
+                  unsigned errlen);
 
 #endif

@@ -15,15 +15,16 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "odo_cli.h"
 #include "odo/odo_can.h"
 
-#define LINE_MAX_CHARS 1024
-#define MAX_SIGNALS    ODO_CAN_MAX_SIGNALS
-#define MAX_TOKENS     (MAX_SIGNALS + 8)
+#define LINE_MAX_CHARS     1024
+#define MAX_SIGNALS        ODO_CAN_MAX_SIGNALS
+#define MAX_TOKENS         (MAX_SIGNALS + 8)
 #define CAN_ERR_FLAG_IN_ID 0x20000000UL
 
 static const char usage_text[] =
-    "usage: odo-canvec [--help]\n"
+    "usage: odo-canvec [--help | --version]\n"
     "\n"
     "Reads commands from stdin, one per line, and answers each on stdout with the firmware's own\n"
     "CAN codec (odo_can.h), so the codec can be checked against can/odometry.dbc in bulk.\n"
@@ -188,8 +189,8 @@ static void cmd_encode(char **tok, int n)
         int64_t lo, hi;
         sig_range(&info->signals[k], &lo, &hi);
         if (v[k] < lo || v[k] > hi) {
-            printf("error range: %s=%" PRId64 " outside the raw range [%" PRId64 ", %" PRId64 "]\n",
-                   name, v[k], lo, hi);
+            printf("error range: %s=%" PRId64 " outside the raw range [%" PRId64 ", %" PRId64 "]\n", name, v[k], lo,
+                   hi);
             return;
         }
         seen[k] = true;
@@ -294,8 +295,7 @@ static void cmd_decode(char **tok, int n)
     odo_can_msg_t m = odo_can_classify(&plain);
     if (m == ODO_CAN_MSG_UNKNOWN) {
         if (f.flags != 0U) {
-            printf("error flags: %s frame 0x%" PRIX32 " is not a data frame of this protocol\n",
-                   frame_kind(&f), f.id);
+            printf("error flags: %s frame 0x%" PRIX32 " is not a data frame of this protocol\n", frame_kind(&f), f.id);
         } else {
             printf("error unknown-id: 0x%03" PRIX32 " is not in can/odometry.dbc\n", f.id);
         }
@@ -313,17 +313,13 @@ static void cmd_decode(char **tok, int n)
         printf("\n");
         break;
     case ODO_CAN_ERR_DLC:
-        printf("error dlc: %s needs DLC %u, frame has %u\n", info->name, (unsigned)info->dlc,
-               (unsigned)f.dlc);
+        printf("error dlc: %s needs DLC %u, frame has %u\n", info->name, (unsigned)info->dlc, (unsigned)f.dlc);
         break;
     case ODO_CAN_ERR_FLAGS:
-        printf("error flags: %s frame 0x%" PRIX32 " is not a data frame of this protocol\n",
-               frame_kind(&f), f.id);
+        printf("error flags: %s frame 0x%" PRIX32 " is not a data frame of this protocol\n", frame_kind(&f), f.id);
         break;
     case ODO_CAN_ERR_ID:
-    default:
-        printf("error unknown-id: codec rejected 0x%03" PRIX32 " as %s\n", f.id, info->name);
-        break;
+    default: printf("error unknown-id: codec rejected 0x%03" PRIX32 " as %s\n", f.id, info->name); break;
     }
 }
 
@@ -334,8 +330,8 @@ static void cmd_list(void)
         printf("message %s 0x%03" PRIX32 " %u\n", info->name, info->id, (unsigned)info->dlc);
         for (unsigned k = 0U; k < info->n_signals; k++) {
             const odo_can_signal_info_t *s = &info->signals[k];
-            printf("signal %s %s %u %u %s\n", info->name, s->name, (unsigned)s->start_bit,
-                   (unsigned)s->bit_len, s->is_signed ? "signed" : "unsigned");
+            printf("signal %s %s %u %u %s\n", info->name, s->name, (unsigned)s->start_bit, (unsigned)s->bit_len,
+                   s->is_signed ? "signed" : "unsigned");
         }
     }
     printf("end\n");
@@ -368,6 +364,10 @@ int main(int argc, char **argv)
     for (int i = 1; i < argc; i++) {
         if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
             fputs(usage_text, stdout);
+            return 0;
+        }
+        if (strcmp(argv[i], "--version") == 0) {
+            odo_cli_print_version("odo-canvec");
             return 0;
         }
         fprintf(stderr, "odo-canvec: unexpected argument '%s'\n\n%s", argv[i], usage_text);

@@ -8,6 +8,7 @@
 /// nominal 340 mm and 1.0), so the return error shows the systematic dead-reckoning error that
 /// UMBmark calibration (a later issue) removes.
 #include <errno.h>
+#include <getopt.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -17,60 +18,73 @@
 #include "candump.h"
 #include "hal_test.h"
 #include "odo/odo_app.h"
+#include "odo_cli.h"
 #include "odo_loop.h"
+#include "odo_out.h"
 #include "odo_ref.h"
 #include "odo_synth.h"
 
 static void usage(FILE *f)
 {
-    fprintf(f, "usage: odo-demo --out DIR [--direction cw|ccw]\n"
+    fprintf(f, "usage: odo-demo --out DIR [--direction cw|ccw] [--force]\n"
+               "       odo-demo --help | --version\n"
                "Runs a 4 x 4 m UMBmark square through the firmware step and writes DIR/pose.csv and\n"
-               "DIR/output.log (candump -l). Prints the return error (000 Eq. 3.1).\n");
+               "DIR/output.log (candump -l). Prints the return error (000 Eq. 3.1).\n"
+               "DIR follows the output rule (hostlib/odo_out.h): built beside itself and renamed into\n"
+               "place; an existing DIR must be empty or a previous odo-demo output unless --force.\n"
+               "Exit status: 0 ok, 1 I/O error or refused output, 2 usage error.\n");
 }
 
 int main(int argc, char **argv)
 {
     const char *out_dir = NULL;
     int ccw = 0;
-    for (int i = 1; i < argc; ++i) {
-        if (strcmp(argv[i], "--out") == 0 && i + 1 < argc) {
-            out_dir = argv[++i];
-        } else if (strcmp(argv[i], "--direction") == 0 && i + 1 < argc) {
-            ++i;
-            if (strcmp(argv[i], "ccw") == 0) {
+    bool force = false;
+    enum { O_OUT = 256, O_DIRECTION, O_FORCE, O_VERSION };
+    static const struct option longopts[] = {
+        {"out", required_argument, NULL, O_OUT}, {"direction", required_argument, NULL, O_DIRECTION},
+        {"force", no_argument, NULL, O_FORCE},   {"version", no_argument, NULL, O_VERSION},
+        {"help", no_argument, NULL, 'h'},        {NULL, 0, NULL, 0}};
+    for (int c; (c = getopt_long(argc, argv, "h", longopts, NULL)) != -1;) {
+        switch (c) {
+        case 'h': usage(stdout); return 0;
+        case O_VERSION: odo_cli_print_version("odo-demo"); return 0;
+        case O_OUT: out_dir = optarg; break;
+        case O_FORCE: force = true; break;
+        case O_DIRECTION:
+            if (strcmp(optarg, "ccw") == 0) {
                 ccw = 1;
-            } else if (strcmp(argv[i], "cw") != 0) {
-                fprintf(stderr, "odo-demo: --direction must be cw or ccw, not '%s'\n", argv[i]);
+            } else if (strcmp(optarg, "cw") != 0) {
+                fprintf(stderr, "odo-demo: --direction must be cw or ccw, not '%s'\n", optarg);
                 return 2;
             }
-        } else if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
-            usage(stdout);
-            return 0;
-        } else {
-            fprintf(stderr, "odo-demo: unknown or incomplete argument '%s'\n", argv[i]);
-            usage(stderr);
-            return 2;
+            break;
+        default: usage(stderr); return 2;
         }
+    }
+    if (optind < argc) {
+        fprintf(stderr, "odo-demo: unexpected argument '%s'\n", argv[optind]);
+        usage(stderr);
+        return 2;
     }
     if (out_dir == NULL) {
         usage(stderr);
         return 2;
     }
-    if (mkdir(out_dir, 0777) != 0 && errno != EEXIST) {
-        fprintf(stderr, "odo-demo: cannot create %s: %s\n", out_dir, strerror(errno));
+    char err[4096 + 256];
+    odo_out_dir_t *dir = odo_out_dir_begin(out_dir, "odo-demo", force, NULL, err, sizeof err);
+    if (dir == NULL) {
+        fprintf(stderr, "odo-demo: cannot write %s\n", err);
         return 1;
     }
-    char pose_path[4096], log_path[4096], pose_tmp[4100], log_tmp[4100];
-    snprintf(pose_path, sizeof pose_path, "%s/pose.csv", out_dir);
-    snprintf(log_path, sizeof log_path, "%s/output.log", out_dir);
-    snprintf(pose_tmp, sizeof pose_tmp, "%s.tmp", pose_path);
-    snprintf(log_tmp, sizeof log_tmp, "%s.tmp", log_path);
-    FILE *pf = fopen(pose_tmp, "w");
-    FILE *lf = fopen(log_tmp, "w");
+    FILE *pf = odo_out_dir_fopen(dir, "pose.csv", err, sizeof err);
+    FILE *lf = pf != NULL ? odo_out_dir_fopen(dir, "output.log", err, sizeof err) : NULL;
     if (pf == NULL || lf == NULL) {
-        fprintf(stderr, "odo-demo: cannot write in %s: %s\n", out_dir, strerror(errno));
-        if (pf) { fclose(pf); remove(pose_tmp); }
-        if (lf) { fclose(lf); remove(log_tmp); }
+        fprintf(stderr, "odo-demo: cannot write %s\n", err);
+        if (pf) {
+            fclose(pf);
+        }
+        odo_out_dir_abort(dir);
         return 1;
     }
 
@@ -130,37 +144,40 @@ int main(int argc, char **argv)
             cr += dr;
             odo_ref_step(&real, dl, dr);
             hal.now_us = t_us;
-            hal_test_set_wheel(&hal, 0U, (uint32_t)((uint64_t)cl & 0xFFFFFFU),
-                               (uint32_t)((uint64_t)cr & 0xFFFFFFU), 24U, seq++);
+            hal_test_set_wheel(&hal, 0U, (uint32_t)((uint64_t)cl & 0xFFFFFFU), (uint32_t)((uint64_t)cr & 0xFFFFFFU),
+                               24U, seq++);
             hal.n_tx = 0U;
             odo_loop_tick(&app, &hal, &loop_in, &out);
             for (uint32_t f = 0U; f < hal.n_tx; ++f) {
                 odo_candump_write(lf, t_us, "vcan0", &hal.tx[f]);
             }
             const odo_pose_t *pose = &out.pose[0];
-            fprintf(pf, "%.3f,%.4f,%.4f,%.6f,%.4f,%.4f,%.6f\n", t_us * 1e-6, pose->x_mm_q32 / 4294967296.0,
-                    pose->y_mm_q32 / 4294967296.0, (double)(int32_t)odo_heading_bam(pose) * (360.0 / 4294967296.0),
-                    real.x_mm, real.y_mm, real.theta_rad * 180.0 / M_PI);
+            fprintf(pf, "%.3f,%.4f,%.4f,%.6f,%.4f,%.4f,%.6f\n", (double)t_us * 1e-6,
+                    (double)pose->x_mm_q32 / 4294967296.0, (double)pose->y_mm_q32 / 4294967296.0,
+                    (double)(int32_t)odo_heading_bam(pose) * (360.0 / 4294967296.0), real.x_mm, real.y_mm,
+                    real.theta_rad * 180.0 / M_PI);
             t_us += p.tick_us;
         }
     }
     const int werr = ferror(pf) || ferror(lf);
-    if (fclose(pf) != 0 || fclose(lf) != 0 || werr || rename(pose_tmp, pose_path) != 0 ||
-        rename(log_tmp, log_path) != 0) {
+    const int cerr = (fclose(pf) != 0) | (fclose(lf) != 0);
+    if (werr || cerr) {
         fprintf(stderr, "odo-demo: writing %s failed: %s\n", out_dir, strerror(errno));
-        remove(pose_tmp);
-        remove(log_tmp);
+        odo_out_dir_abort(dir);
+        return 1;
+    }
+    if (odo_out_dir_commit(dir, err, sizeof err) != 0) {
+        fprintf(stderr, "odo-demo: cannot write %s\n", err);
         return 1;
     }
     const odo_pose_t *pose = &out.pose[0];
-    const double xc = pose->x_mm_q32 / 4294967296.0, yc = pose->y_mm_q32 / 4294967296.0;
+    const double xc = (double)pose->x_mm_q32 / 4294967296.0, yc = (double)pose->y_mm_q32 / 4294967296.0;
     const double thc = (double)(int32_t)odo_heading_bam(pose) * (360.0 / 4294967296.0);
-    printf("odo-demo: %s square, %u ticks, %u frames published\n", ccw ? "ccw" : "cw", app.ticks,
-           app.ticks * 3U);
+    printf("odo-demo: %s square, %u ticks, %u frames published\n", ccw ? "ccw" : "cw", app.ticks, app.ticks * 3U);
     printf("  firmware believes  x %8.1f mm  y %8.1f mm  theta %7.2f deg\n", xc, yc, thc);
     printf("  robot really is    x %8.1f mm  y %8.1f mm  theta %7.2f deg\n", real.x_mm, real.y_mm,
            remainder(real.theta_rad * 180.0 / M_PI, 360.0));
     printf("  return error (000 Eq. 3.1)  ex %.1f mm  ey %.1f mm\n", real.x_mm - xc, real.y_mm - yc);
-    printf("  wrote %s and %s\n", pose_path, log_path);
+    printf("  wrote %s/pose.csv and %s/output.log\n", out_dir, out_dir);
     return 0;
 }

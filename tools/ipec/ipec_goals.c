@@ -78,7 +78,8 @@ int ipec_cmd_goals(int argc, char **argv)
     static sim_scenario_t floor_sc, setsim, none, lbias, rbias;
     char path[4096];
     snprintf(path, sizeof path, "%s/host_sim/scenarios/set-sim.json", ipec_src_dir());
-    if (ipec_load("clapper", NULL, NULL, &clapper, &none) != 0 || ipec_load("labmate", NULL, path, &labmate, &setsim) != 0 ||
+    if (ipec_load("clapper", NULL, NULL, &clapper, &none) != 0 ||
+        ipec_load("labmate", NULL, path, &labmate, &setsim) != 0 ||
         ipec_load("set", NULL, NULL, &set, &floor_sc) != 0) {
         return 1;
     }
@@ -176,8 +177,8 @@ int ipec_cmd_goals(int argc, char **argv)
         return 1;
     }
     fprintf(stderr, "odo-ipec: selfcal Ed %.5f/%.5f Eb %.5f/%.5f (true %.5f, %.5f); link %.3f/%.3f deg %.3f mm\n",
-            scal.ed[0], scal.ed[1], scal.eb[0], scal.eb[1], ed_true, eb_true, slink.alpha_bias_deg,
-            slink.beta_bias_deg, slink.length_bias_mm);
+            scal.ed[0], scal.ed[1], scal.eb[0], scal.eb[1], ed_true, eb_true, slink.alpha_bias_deg, slink.beta_bias_deg,
+            slink.length_bias_mm);
 
     printf("{\n  \"runs_per_case\": %u,\n  \"straight_36m\": {\n", n);
     put_case("off_10_bumps", &s_off, 0);
@@ -213,15 +214,17 @@ int ipec_cmd_goals(int argc, char **argv)
            tb.max_true_deg, tb.max_est_deg, predicted, hypot(rb.ex_mm, rb.ey_mm), rb.etheta_deg);
     printf(",\n  \"selfcal\": {\"true_ed\": %.6f, \"true_eb\": %.6f, \"truck\": [", ed_true, eb_true);
     for (unsigned i = 0; i < ODO_TRUCKS; ++i) {
-        printf("{\"ed\": %.6f, \"eb\": %.6f, \"one_sided_corr_deg_before\": %.3f, \"one_sided_corr_deg_after\": %.3f}%s",
-               scal.ed[i], scal.eb[i], scal.one_sided_before_deg[i], scal.one_sided_after_deg[i],
-               i + 1U < ODO_TRUCKS ? ", " : "]},\n");
+        printf(
+            "{\"ed\": %.6f, \"eb\": %.6f, \"one_sided_corr_deg_before\": %.3f, \"one_sided_corr_deg_after\": %.3f}%s",
+            scal.ed[i], scal.eb[i], scal.one_sided_before_deg[i], scal.one_sided_after_deg[i],
+            i + 1U < ODO_TRUCKS ? ", " : "]},\n");
     }
-    printf("  \"selfcal_link\": {\"true_alpha_bias_deg\": %.3f, \"true_beta_bias_deg\": %.3f, \"true_length_bias_mm\": %.3f, "
-           "\"alpha_bias_deg\": %.4f, \"beta_bias_deg\": %.4f, \"length_bias_mm\": %.4f, "
-           "\"far_mark_etheta_before_deg\": %.3f, \"far_mark_etheta_after_deg\": %.3f, "
-           "\"umbmark_etheta_before_deg\": [%.3f, %.3f], \"umbmark_etheta_after_deg\": [%.3f, %.3f]}\n}\n",
-           a_true, b_true, l_true, slink.alpha_bias_deg, slink.beta_bias_deg, slink.length_bias_mm, slink.rotary_before[0],
-           slink.rotary_after[0], slink.link_before[0], slink.link_before[1], slink.link_after[0], slink.link_after[1]);
+    printf(
+        "  \"selfcal_link\": {\"true_alpha_bias_deg\": %.3f, \"true_beta_bias_deg\": %.3f, \"true_length_bias_mm\": %.3f, "
+        "\"alpha_bias_deg\": %.4f, \"beta_bias_deg\": %.4f, \"length_bias_mm\": %.4f, "
+        "\"far_mark_etheta_before_deg\": %.3f, \"far_mark_etheta_after_deg\": %.3f, "
+        "\"umbmark_etheta_before_deg\": [%.3f, %.3f], \"umbmark_etheta_after_deg\": [%.3f, %.3f]}\n}\n",
+        a_true, b_true, l_true, slink.alpha_bias_deg, slink.beta_bias_deg, slink.length_bias_mm, slink.rotary_before[0],
+        slink.rotary_after[0], slink.link_before[0], slink.link_before[1], slink.link_after[0], slink.link_after[1]);
     return 0;
 }

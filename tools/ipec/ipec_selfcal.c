@@ -30,23 +30,21 @@ void ipec_apply_params(sim_robot_t *r, const odo_params_t *p)
     }
 }
 
-int ipec_write_params(const char *path, const odo_params_t *p)
+/// Finish the params JSON begun with odo_out_file_begin (hostlib/odo_out.h); aborts it when p is NULL.
+int ipec_write_params(odo_out_file_t *o, const odo_params_t *p)
 {
-    char tmp[4096];
-    snprintf(tmp, sizeof tmp, "%s.tmp.%ld", path, (long)getpid());
-    FILE *f = fopen(tmp, "w");
-    if (f == NULL) {
-        fprintf(stderr, "odo-ipec: cannot write %s\n", tmp);
+    char err[4096 + 256];
+    if (p == NULL) {
+        odo_out_file_abort(o);
         return -1;
     }
-    if (odo_params_json_write(f, p) != 0 || fclose(f) != 0) {
-        fprintf(stderr, "odo-ipec: cannot write %s\n", tmp);
-        remove(tmp);
+    if (odo_params_json_write(o->f, p) != 0) {
+        fprintf(stderr, "odo-ipec: cannot write %s\n", o->path);
+        odo_out_file_abort(o);
         return -1;
     }
-    if (rename(tmp, path) != 0) {
-        fprintf(stderr, "odo-ipec: cannot rename %s to %s\n", tmp, path);
-        remove(tmp);
+    if (odo_out_file_commit(o, err, sizeof err) != 0) {
+        fprintf(stderr, "odo-ipec: %s\n", err);
         return -1;
     }
     return 0;
@@ -57,9 +55,9 @@ int ipec_write_params(const char *path, const odo_params_t *p)
  * ------------------------------------------------------------------------------------------- */
 typedef struct {
     odo_selfcal_t cal;
-    odo_params_t  p;            ///< what the firmware runs with
-    double        abs_corr_deg[ODO_TRUCKS]; ///< sum |C|
-    double        corr_deg[ODO_TRUCKS];     ///< sum C
+    odo_params_t p;                  ///< what the firmware runs with
+    double abs_corr_deg[ODO_TRUCKS]; ///< sum |C|
+    double corr_deg[ODO_TRUCKS];     ///< sum C
 } sc_ctx_t;
 
 static void sc_tick(void *user, const sim_tick_t *tk)
@@ -85,7 +83,7 @@ static double one_sided_deg(const odo_selfcal_truck_t *t)
 }
 
 static int selfcal_runs(const sim_robot_t *robot, const sim_scenario_t *sc, const char *exp, unsigned runs, int ipec,
-                      uint64_t seed, sc_ctx_t *ctx)
+                        uint64_t seed, sc_ctx_t *ctx)
 {
     char err[256];
     memset(ctx, 0, sizeof *ctx);
@@ -129,7 +127,7 @@ int ipec_selfcal(const sim_robot_t *robot, const sim_scenario_t *sc, const char 
         out->eb[i] = out->params.truck[i].eb_q30 / TWO30;
         out->have_ed[i] = res.have_ed[i];
         out->have_eb[i] = res.have_eb[i];
-        out->straight_m[i] = before.cal.truck[i].straight_um / 1e6;
+        out->straight_m[i] = (double)before.cal.truck[i].straight_um / 1e6;
         out->turn_deg[i] = ipec_bam_deg(before.cal.truck[i].turn_bam);
         out->corr_deg_per_m[i] = ipec_bam_deg(res.corr_per_m_bam[i]);
         out->corr_deg_per_turn[i] = ipec_bam_deg(res.corr_per_turn_bam[i]);
@@ -145,7 +143,7 @@ int ipec_selfcal(const sim_robot_t *robot, const sim_scenario_t *sc, const char 
  * 004 s. 5.2: rotary-encoder bias and link-length bias, against an external reference
  * ------------------------------------------------------------------------------------------- */
 typedef struct {
-    double far_x;             ///< firmware x of A at the far end (largest so far)
+    double far_x; ///< firmware x of A at the far end (largest so far)
     double e_theta_deg, e_y_mm;
 } far_t;
 
@@ -193,7 +191,7 @@ static int measure(const sim_robot_t *base, const sim_scenario_t *sc, const odo_
 /// The external reference of the calibration bay (004 s. 6: sonar on the vehicle; here the
 /// simulator's truth): both trucks' true poses every tick, hence the true alpha, beta and l.
 typedef struct {
-    double sum_a, sum_b, sum_l;     ///< code centre - true angle (deg) over sweep ticks; l_meas - l_true (mm)
+    double sum_a, sum_b, sum_l; ///< code centre - true angle (deg) over sweep ticks; l_meas - l_true (mm)
     unsigned n_a, n_b, n_l;
     uint16_t last_a, last_b;
     bool have_last;
@@ -371,27 +369,47 @@ int ipec_cmd_selfcal(int argc, char **argv, int link)
     if (load_start("clapper", robot_path, scenario, params, &robot, &sc, &start) != 0) {
         return 1;
     }
+    /* The output is checked (and its temp made) before the runs: an input is never overwritten. */
+    char err[4096 + 256];
+    odo_out_inputs_t ins;
+    odo_out_inputs_init(&ins);
+    (void)odo_out_inputs_add(&ins, robot_path, err, sizeof err);
+    (void)odo_out_inputs_add(&ins, scenario, err, sizeof err);
+    (void)odo_out_inputs_add(&ins, params, err, sizeof err);
+    odo_out_file_t of;
+    if (odo_out_file_begin(&of, out, &ins, err, sizeof err) != 0) {
+        fprintf(stderr, "odo-ipec: %s\n", err);
+        return 1;
+    }
     if (!link) {
         static ipec_selfcal_t r;
-        if (ipec_selfcal(&robot, &sc, exp, (unsigned)runs, ipec, (uint64_t)seed, &r) != 0 ||
-            ipec_write_params(out, &r.params) != 0) {
+        if (ipec_selfcal(&robot, &sc, exp, (unsigned)runs, ipec, (uint64_t)seed, &r) != 0) {
+            odo_out_file_abort(&of);
             return 1;
         }
-        printf("{\n  \"experiment\": \"%s\", \"runs_per_direction\": %ld, \"params\": \"%s\",\n  \"truck\": [\n", exp, runs,
-               out);
+        if (ipec_write_params(&of, &r.params) != 0) {
+            return 1;
+        }
+        printf("{\n  \"experiment\": \"%s\", \"runs_per_direction\": %ld, \"params\": \"%s\",\n  \"truck\": [\n", exp,
+               runs, out);
         for (unsigned i = 0; i < ODO_TRUCKS; ++i) {
-            printf("    {\"ed\": %.6f, \"eb\": %.6f, \"straight_m\": %.2f, \"turn_deg\": %.1f, "
-                   "\"corr_deg_per_m\": %.5f, \"corr_deg_per_turn\": %.4f, \"one_sided_corr_deg_before\": %.3f, "
-                   "\"one_sided_corr_deg_after\": %.3f, \"abs_corr_deg_before\": %.3f, \"abs_corr_deg_after\": %.3f}%s\n",
-                   r.ed[i], r.eb[i], r.straight_m[i], r.turn_deg[i], r.corr_deg_per_m[i], r.corr_deg_per_turn[i],
-                   r.one_sided_before_deg[i], r.one_sided_after_deg[i], r.abs_before_deg[i], r.abs_after_deg[i],
-                   i + 1U < ODO_TRUCKS ? "," : "");
+            printf(
+                "    {\"ed\": %.6f, \"eb\": %.6f, \"straight_m\": %.2f, \"turn_deg\": %.1f, "
+                "\"corr_deg_per_m\": %.5f, \"corr_deg_per_turn\": %.4f, \"one_sided_corr_deg_before\": %.3f, "
+                "\"one_sided_corr_deg_after\": %.3f, \"abs_corr_deg_before\": %.3f, \"abs_corr_deg_after\": %.3f}%s\n",
+                r.ed[i], r.eb[i], r.straight_m[i], r.turn_deg[i], r.corr_deg_per_m[i], r.corr_deg_per_turn[i],
+                r.one_sided_before_deg[i], r.one_sided_after_deg[i], r.abs_before_deg[i], r.abs_after_deg[i],
+                i + 1U < ODO_TRUCKS ? "," : "");
         }
         printf("  ]\n}\n");
         return 0;
     }
     static ipec_selfcal_link_t r;
-    if (ipec_selfcal_link(&robot, &sc, &start, &r) != 0 || ipec_write_params(out, &r.params) != 0) {
+    if (ipec_selfcal_link(&robot, &sc, &start, &r) != 0) {
+        odo_out_file_abort(&of);
+        return 1;
+    }
+    if (ipec_write_params(&of, &r.params) != 0) {
         return 1;
     }
     printf("{\n  \"params\": \"%s\",\n  \"alpha_bias_deg\": %.4f, \"beta_bias_deg\": %.4f, \"length_bias_mm\": %.4f,\n"

@@ -2,6 +2,7 @@
 #ifndef IPEC_TOOL_H
 #define IPEC_TOOL_H
 
+#include "odo_out.h"
 #include <stdbool.h>
 #include <stdint.h>
 
@@ -19,8 +20,8 @@ int ipec_load(const char *vehicle, const char *robot_path, const char *scenario_
               sim_scenario_t *sc);
 
 /// One run, seeded as odo-sim seeds run `run` of direction ccw. ipec: 0 off, 1 paper, 2 estimator.
-int ipec_run(const sim_robot_t *robot, const sim_scenario_t *sc, const char *experiment, int ccw, int bumps,
-             int ipec, uint64_t seed, unsigned run, sim_tick_fn fn, void *user, sim_return_t *ret);
+int ipec_run(const sim_robot_t *robot, const sim_scenario_t *sc, const char *experiment, int ccw, int bumps, int ipec,
+             uint64_t seed, unsigned run, sim_tick_fn fn, void *user, sim_return_t *ret);
 
 double ipec_bam_deg(int64_t bam);
 double ipec_est_theta_deg(const odo_pose_t *p);
@@ -29,15 +30,16 @@ int ipec_cmd_goals(int argc, char **argv);
 
 /// The robot's calibration fields (Ed, Eb, Es per truck; link biases) from a parameter block.
 void ipec_apply_params(sim_robot_t *r, const odo_params_t *p);
-/// Write a parameter block as JSON (params_json.h) through a temp file and a rename. 0 or -1.
-int ipec_write_params(const char *path, const odo_params_t *p);
+/// Write a parameter block as JSON (params_json.h) into the output begun with odo_out_file_begin
+/// and commit it (hostlib/odo_out.h); p NULL aborts it. 0 or -1 (message on stderr).
+int ipec_write_params(odo_out_file_t *o, const odo_params_t *p);
 
 /// 004 s. 5.1: Ed and Eb of both trucks from IPEC's corrections (odo_selfcal.h) over `runs` cw and
 /// `runs` ccw runs of `exp`, then the same runs again with the estimate (the "after" figures).
 typedef struct {
-    odo_params_t params;                       ///< the robot's block with the estimated Ed, Eb
+    odo_params_t params; ///< the robot's block with the estimated Ed, Eb
     double ed[ODO_TRUCKS], eb[ODO_TRUCKS];
-    bool   have_ed[ODO_TRUCKS], have_eb[ODO_TRUCKS];
+    bool have_ed[ODO_TRUCKS], have_eb[ODO_TRUCKS];
     double straight_m[ODO_TRUCKS], turn_deg[ODO_TRUCKS];
     double corr_deg_per_m[ODO_TRUCKS], corr_deg_per_turn[ODO_TRUCKS];
     double one_sided_before_deg[ODO_TRUCKS], one_sided_after_deg[ODO_TRUCKS]; ///< systematic part

@@ -10,12 +10,14 @@
 #include <unistd.h>
 
 #include "data_dir.h"
+#include "odo_cli.h"
 #include "ipec_tool.h"
 
 static void usage(FILE *f)
 {
     fprintf(f,
             "usage: odo-ipec goals [--runs N] [--quick]\n"
+            "       odo-ipec --help | --version\n"
             "       odo-ipec trace --experiment E --vehicle clapper|set [--ipec off|paper|estimator]\n"
             "                      [--scenario S.json] [--robot R.json] [--ccw] [--bumps N] [--run K] [--seed S]\n"
             "       odo-ipec selfcal --scenario S.json --out P.json [--robot R.json] [--params P0.json]\n"
@@ -75,13 +77,20 @@ int ipec_load(const char *vehicle, const char *robot_path, const char *scenario_
     return 0;
 }
 
-int ipec_run(const sim_robot_t *robot, const sim_scenario_t *sc, const char *experiment, int ccw, int bumps,
-             int ipec, uint64_t seed, unsigned run, sim_tick_fn fn, void *user, sim_return_t *ret)
+int ipec_run(const sim_robot_t *robot, const sim_scenario_t *sc, const char *experiment, int ccw, int bumps, int ipec,
+             uint64_t seed, unsigned run, sim_tick_fn fn, void *user, sim_return_t *ret)
 {
     char err[512];
     const sim_run_config_t cfg = {
-        .robot = robot, .scenario = sc, .experiment = experiment, .ccw = ccw, .bumps = bumps,
-        .bump_height_mm = 10.0, .ipec = ipec, .seed = sim_run_seed(seed, ccw, run), .run_index = run,
+        .robot = robot,
+        .scenario = sc,
+        .experiment = experiment,
+        .ccw = ccw,
+        .bumps = bumps,
+        .bump_height_mm = 10.0,
+        .ipec = ipec,
+        .seed = sim_run_seed(seed, ccw, run),
+        .run_index = run,
     };
     if (sim_run(&cfg, fn, user, ret, err, sizeof err) != 0) {
         fprintf(stderr, "odo-ipec: %s\n", err);
@@ -94,10 +103,7 @@ double ipec_bam_deg(int64_t bam) { return (double)bam * (360.0 / 4294967296.0); 
 
 static double wrap_deg(double d) { return remainder(d, 360.0); }
 
-double ipec_est_theta_deg(const odo_pose_t *p)
-{
-    return ipec_bam_deg((int32_t)odo_heading_bam(p));
-}
+double ipec_est_theta_deg(const odo_pose_t *p) { return ipec_bam_deg((int32_t)odo_heading_bam(p)); }
 
 /* ---------------------------------------------------------------------------------------------
  * trace
@@ -108,10 +114,9 @@ static void trace_tick(void *user, const sim_tick_t *tk)
     const odo_tick_output_t *o = tk->output;
     const double ta = tk->truth[0].theta_rad * 180.0 / M_PI, tb = tk->truth[1].theta_rad * 180.0 / M_PI;
     const double ea = ipec_est_theta_deg(&o->pose[0]), eb = ipec_est_theta_deg(&o->pose[1]);
-    printf("%.3f,%.2f,%.2f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.3f,%u,%zu\n", tk->t_s,
-           tk->truth[0].x_mm, tk->truth[0].y_mm, ta, wrap_deg(ea - ta), wrap_deg(eb - tb),
-           tk->link.alpha_rad * 180.0 / M_PI, tk->link.beta_rad * 180.0 / M_PI,
-           ipec_bam_deg(o->ipec_dtheta_bam[0]), ipec_bam_deg(o->ipec_dtheta_bam[1]),
+    printf("%.3f,%.2f,%.2f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.3f,%u,%zu\n", tk->t_s, tk->truth[0].x_mm,
+           tk->truth[0].y_mm, ta, wrap_deg(ea - ta), wrap_deg(eb - tb), tk->link.alpha_rad * 180.0 / M_PI,
+           tk->link.beta_rad * 180.0 / M_PI, ipec_bam_deg(o->ipec_dtheta_bam[0]), ipec_bam_deg(o->ipec_dtheta_bam[1]),
            ipec_bam_deg(o->ipec_innov_bam[0]), ipec_bam_deg(o->ipec_innov_bam[1]),
            ipec_bam_deg((int32_t)(uint32_t)((uint32_t)tk->input->link.alpha_bam16 << 16)), tk->link.length_mm,
            (unsigned)o->faults, tk->n_events);
@@ -212,6 +217,13 @@ static int cmd_trace(int argc, char **argv)
 
 int main(int argc, char **argv)
 {
+    if (!odo_cli_split_equals(&argc, &argv)) {
+        return 1;
+    }
+    if (argc >= 2 && strcmp(argv[1], "--version") == 0) {
+        odo_cli_print_version("odo-ipec");
+        return 0;
+    }
     if (argc < 2 || strcmp(argv[1], "--help") == 0 || strcmp(argv[1], "-h") == 0) {
         usage(argc < 2 ? stderr : stdout);
         return argc < 2 ? 2 : 0;

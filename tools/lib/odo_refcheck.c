@@ -8,9 +8,8 @@
 
 static double wrap_pi(double a) { return fabs(remainder(a, 2.0 * M_PI)); }
 
-int odo_refcheck_run(uint64_t seed, uint8_t bits, uint8_t heading_form,
-                     const odo_truck_params_t *model_params, const odo_truck_params_t *ref_params,
-                     double distance_mm, odo_refcheck_t *out)
+int odo_refcheck_run(uint64_t seed, uint8_t bits, uint8_t heading_form, const odo_truck_params_t *model_params,
+                     const odo_truck_params_t *ref_params, double distance_mm, odo_refcheck_t *out)
 {
     odo_model_t m;
     if (odo_model_init(&m, model_params, bits, heading_form, 40000U, 3000U) != ODO_MODEL_OK) {
@@ -27,8 +26,7 @@ int odo_refcheck_run(uint64_t seed, uint8_t bits, uint8_t heading_form,
     const uint64_t mask = bits >= 32U ? 0xFFFFFFFFULL : ((1ULL << bits) - 1U);
     int64_t count[2] = {(int64_t)mask - 5000, (int64_t)mask - 12345}; /* wrap early */
     odo_step_t st;
-    odo_truck_step(&t, &m, (uint32_t)((uint64_t)count[0] & mask), (uint32_t)((uint64_t)count[1] & mask),
-                   bits, 1U, &st);
+    odo_truck_step(&t, &m, (uint32_t)((uint64_t)count[0] & mask), (uint32_t)((uint64_t)count[1] & mask), bits, 1U, &st);
     out->max_pos_err_mm = 0.0;
     out->ticks = 0U;
     out->wraps = 0U;
@@ -42,8 +40,8 @@ int odo_refcheck_run(uint64_t seed, uint8_t bits, uint8_t heading_form,
                 out->wraps++;
             }
         }
-        odo_truck_step(&t, &m, (uint32_t)((uint64_t)count[0] & mask),
-                       (uint32_t)((uint64_t)count[1] & mask), bits, 1U, &st);
+        odo_truck_step(&t, &m, (uint32_t)((uint64_t)count[0] & mask), (uint32_t)((uint64_t)count[1] & mask), bits, 1U,
+                       &st);
         odo_ref_step(&r, d[0], d[1]);
         out->ticks++;
         const double ex = (double)t.pose.x_mm_q32 / 4294967296.0 - r.x_mm;

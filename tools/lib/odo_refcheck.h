@@ -9,12 +9,12 @@
 #include "odo/odo_params.h"
 
 typedef struct {
-    double pos_err_mm;       ///< |firmware - reference| position at the end
-    double heading_err_rad;  ///< |firmware - reference| heading at the end, wrapped to [0, pi]
-    double max_pos_err_mm;   ///< largest position difference seen along the way
-    double distance_mm;      ///< path length driven
+    double pos_err_mm;      ///< |firmware - reference| position at the end
+    double heading_err_rad; ///< |firmware - reference| heading at the end, wrapped to [0, pi]
+    double max_pos_err_mm;  ///< largest position difference seen along the way
+    double distance_mm;     ///< path length driven
     uint32_t ticks;
-    uint32_t wraps;          ///< counter wraparounds crossed (both wheels)
+    uint32_t wraps; ///< counter wraparounds crossed (both wheels)
 } odo_refcheck_t;
 
 /// Drive random mixed paths (odo_synth) for `distance_mm`, with counters of `bits` width
@@ -22,8 +22,7 @@ typedef struct {
 /// `model_params` feeds the firmware, `ref_params` the reference (equal for a fair comparison;
 /// tests pass different ones to show the check is sensitive). Returns 0, or -1 if the firmware
 /// refused the parameters.
-int odo_refcheck_run(uint64_t seed, uint8_t bits, uint8_t heading_form,
-                     const odo_truck_params_t *model_params, const odo_truck_params_t *ref_params,
-                     double distance_mm, odo_refcheck_t *out);
+int odo_refcheck_run(uint64_t seed, uint8_t bits, uint8_t heading_form, const odo_truck_params_t *model_params,
+                     const odo_truck_params_t *ref_params, double distance_mm, odo_refcheck_t *out);
 
 #endif

@@ -10,13 +10,13 @@
 
 typedef struct {
     uint64_t rng;
-    double   k_mm;            ///< nominal distance per count
-    double   b_mm;            ///< nominal wheelbase
-    double   tick_s;
-    double   acc[2];          ///< fractional counts carried to the next tick
-    double   rate[2];         ///< counts per tick of the current segment, [left, right]
-    uint32_t remaining;       ///< ticks left in the current segment
-    double   distance_mm;     ///< centre-point path length so far (|U| summed)
+    double k_mm; ///< nominal distance per count
+    double b_mm; ///< nominal wheelbase
+    double tick_s;
+    double acc[2];      ///< fractional counts carried to the next tick
+    double rate[2];     ///< counts per tick of the current segment, [left, right]
+    uint32_t remaining; ///< ticks left in the current segment
+    double distance_mm; ///< centre-point path length so far (|U| summed)
 } odo_synth_t;
 
 void odo_synth_init(odo_synth_t *s, uint64_t seed, const odo_truck_params_t *tp, uint32_t tick_us);

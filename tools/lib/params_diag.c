@@ -20,8 +20,8 @@ void odo_params_qualified_name(odo_param_field_t f, uint8_t truck, char *out, si
     }
 }
 
-void odo_params_explain(odo_params_status_t st, const uint8_t *b, size_t n, char *field, size_t fcap,
-                        char *detail, size_t dcap)
+void odo_params_explain(odo_params_status_t st, const uint8_t *b, size_t n, char *field, size_t fcap, char *detail,
+                        size_t dcap)
 {
     field[0] = '\0';
     detail[0] = '\0';
@@ -37,8 +37,8 @@ void odo_params_explain(odo_params_status_t st, const uint8_t *b, size_t n, char
     }
     case ODO_PARAMS_ERR_MAGIC:
         snprintf(field, fcap, "magic");
-        snprintf(detail, dcap, "first bytes %02X %02X %02X %02X, expected 4F 44 4F 50 ('ODOP')", b[0], b[1],
-                 b[2], b[3]);
+        snprintf(detail, dcap, "first bytes %02X %02X %02X %02X, expected 4F 44 4F 50 ('ODOP')", b[0], b[1], b[2],
+                 b[3]);
         break;
     case ODO_PARAMS_ERR_VERSION:
         snprintf(field, fcap, "version");
@@ -75,13 +75,12 @@ void odo_params_explain(odo_params_status_t st, const uint8_t *b, size_t n, char
             snprintf(detail, dcap, "field %s = %" PRId64 " is outside [%" PRId64 ", %" PRId64 "]", field,
                      odo_params_get(&p, f, t), fi->min, fi->max);
         } else {
-            snprintf(detail, dcap, "field %s = %" PRIu32 "/%" PRIu32 ": the minimum must be below the maximum",
-                     field, p.link.length_min_um, p.link.length_max_um);
+            snprintf(detail, dcap, "field %s = %" PRIu32 "/%" PRIu32 ": the minimum must be below the maximum", field,
+                     p.link.length_min_um, p.link.length_max_um);
         }
         break;
     }
     case ODO_PARAMS_OK:
-    case ODO_PARAMS_ERR_ARG:
-        break;
+    case ODO_PARAMS_ERR_ARG: break;
     }
 }

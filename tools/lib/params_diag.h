@@ -17,7 +17,7 @@ void odo_params_qualified_name(odo_param_field_t f, uint8_t truck, char *out, si
 /// `detail` the specifics with the offending value ("version 3, this tool reads 1 and 2",
 /// "field truck[1].scrub_q30 = 300000000 is outside [-268435456, 268435456]", "reserved byte at
 /// offset 140 is 0x01, must be 0"). Both empty for ODO_PARAMS_OK.
-void odo_params_explain(odo_params_status_t st, const uint8_t *b, size_t n, char *field, size_t fcap,
-                        char *detail, size_t dcap);
+void odo_params_explain(odo_params_status_t st, const uint8_t *b, size_t n, char *field, size_t fcap, char *detail,
+                        size_t dcap);
 
 #endif

@@ -7,6 +7,7 @@
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include "params_diag.h"
 
@@ -33,12 +34,12 @@ static const odo_param_field_info_t *find_field(odo_param_scope_t scope, const c
 /// every field the version carries is required, one it does not carry must be absent, and any
 /// key that is neither a field nor in `allowed` fails.
 static int read_fields(json_t *o, odo_param_scope_t scope, uint8_t truck, unsigned version, odo_params_t *p,
-                       const char *origin, const char *prefix, const char *const *allowed, char *err,
-                       size_t errlen)
+                       const char *origin, const char *prefix, const char *const *allowed, char *err, size_t errlen)
 {
     const char *key;
     json_t *v;
-    json_object_foreach(o, key, v) {
+    json_object_foreach(o, key, v)
+    {
         const odo_param_field_info_t *f = find_field(scope, key);
         int known = f != NULL;
         for (const char *const *a = allowed; !known && a != NULL && *a != NULL; ++a) {
@@ -49,8 +50,8 @@ static int read_fields(json_t *o, odo_param_scope_t scope, uint8_t truck, unsign
             return -1;
         }
         if (f != NULL && f->since > version) {
-            snprintf(err, errlen, "%s: %s%s: not part of a version-%u block (it came with version %u)", origin,
-                     prefix, key, version, f->since);
+            snprintf(err, errlen, "%s: %s%s: not part of a version-%u block (it came with version %u)", origin, prefix,
+                     key, version, f->since);
             return -1;
         }
     }
@@ -74,11 +75,14 @@ static int read_fields(json_t *o, odo_param_scope_t scope, uint8_t truck, unsign
         case ODO_PTYPE_U8: hi = UINT8_MAX; break;
         case ODO_PTYPE_U16: hi = UINT16_MAX; break;
         case ODO_PTYPE_U32: hi = UINT32_MAX; break;
-        case ODO_PTYPE_I32: lo = INT32_MIN; hi = INT32_MAX; break;
+        case ODO_PTYPE_I32:
+            lo = INT32_MIN;
+            hi = INT32_MAX;
+            break;
         }
         if (val < lo || val > hi) {
-            snprintf(err, errlen, "%s: %s%s: %lld does not fit its field [%lld, %lld]", origin, prefix,
-                     json_key(f), (long long)val, lo, hi);
+            snprintf(err, errlen, "%s: %s%s: %lld does not fit its field [%lld, %lld]", origin, prefix, json_key(f),
+                     (long long)val, lo, hi);
             return -1;
         }
         (void)odo_params_set(p, (odo_param_field_t)f->id, truck, (int64_t)val);
@@ -97,8 +101,8 @@ int odo_params_json_parse(const char *text, const char *origin, odo_params_t *ou
     int rc = -1;
     odo_params_t p;
     odo_params_defaults(&p);
-    static const char *const k_meta[] = {"file", "status", "magic", "version", "length", "crc32",
-                                         "comment", "truck", "link", NULL};
+    static const char *const k_meta[] = {"file",  "status",  "magic", "version", "length",
+                                         "crc32", "comment", "truck", "link",    NULL};
     unsigned version = ODO_PARAMS_VERSION;
     if (!json_is_object(root)) {
         snprintf(err, errlen, "%s: the top level must be an object", origin);
@@ -179,7 +183,12 @@ static char *slurp(const char *path, size_t *len, char *err, size_t errlen)
         snprintf(err, errlen, "%s: cannot open: %s", path, strerror(errno));
         return NULL;
     }
-    const size_t cap = 1U << 20;
+    /* As large as the file (up to the 1 MiB cap), not the cap each time. */
+    struct stat sb;
+    const size_t limit = 1U << 20;
+    const size_t cap = (fstat(fileno(f), &sb) == 0 && sb.st_size >= 0 && (uint64_t)sb.st_size < limit)
+                           ? (size_t)sb.st_size + 1U
+                           : limit;
     char *buf = malloc(cap + 1U);
     if (buf == NULL) {
         fclose(f);
@@ -189,8 +198,12 @@ static char *slurp(const char *path, size_t *len, char *err, size_t errlen)
     const size_t n = fread(buf, 1, cap + 1U, f);
     const int bad = ferror(f);
     fclose(f);
-    if (bad || n > cap) {
-        snprintf(err, errlen, bad ? "%s: read error" : "%s: larger than 1 MiB, not a parameter file", path);
+    if (bad || n > limit || (n == cap && cap < limit)) { /* over the cap, or grew while read */
+        snprintf(err, errlen,
+                 bad         ? "%s: read error"
+                 : n > limit ? "%s: larger than 1 MiB, not a parameter file"
+                             : "%s: changed while it was read",
+                 path);
         free(buf);
         return NULL;
     }
@@ -238,8 +251,8 @@ int odo_params_file_load(const char *path, odo_params_t *p, char *err, size_t er
                      odo_params_status_str(st), detail[0] != '\0' ? ": " : "", detail);
             rc = -1;
         } else if (n != want) {
-            snprintf(err, errlen, "%s: %zu bytes: a raw parameter block file must be exactly its %zu bytes", path,
-                     n, want);
+            snprintf(err, errlen, "%s: %zu bytes: a raw parameter block file must be exactly its %zu bytes", path, n,
+                     want);
             rc = -1;
         } else {
             *p = q;
@@ -287,8 +300,9 @@ void odo_params_json_fields(FILE *f, const odo_params_t *p, unsigned version)
 
 int odo_params_json_write_stored(FILE *f, const odo_params_t *p, unsigned version, uint32_t crc)
 {
-    fprintf(f, "{\"status\": \"ok\", \"magic\": \"ODOP\", \"version\": %u, \"length\": %zu, "
-               "\"crc32\": \"0x%08" PRIX32 "\",\n",
+    fprintf(f,
+            "{\"status\": \"ok\", \"magic\": \"ODOP\", \"version\": %u, \"length\": %zu, "
+            "\"crc32\": \"0x%08" PRIX32 "\",\n",
             version, odo_params_version_size((uint16_t)version), crc);
     odo_params_json_fields(f, p, version);
     fputs("}\n", f);

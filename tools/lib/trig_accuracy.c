@@ -19,10 +19,7 @@ static uint64_t splitmix64(uint64_t *state)
 }
 
 /// Uniform in [0, 1) with 53 random bits.
-static double unit_uniform(uint64_t *state)
-{
-    return (double)(splitmix64(state) >> 11) * (1.0 / 9007199254740992.0);
-}
+static double unit_uniform(uint64_t *state) { return (double)(splitmix64(state) >> 11) * (1.0 / 9007199254740992.0); }
 
 static double max_d(double a, double b) { return a > b ? a : b; }
 
@@ -57,8 +54,7 @@ static void random_vector(uint64_t *state, uint32_t i, int64_t *y, int64_t *x)
         const unsigned ey = (unsigned)(splitmix64(state) % 63U);
         const uint64_t bits = splitmix64(state);
         const int64_t mx = (int64_t)(((uint64_t)1U << ex) | (bits & (((uint64_t)1U << ex) - 1U)));
-        const int64_t my =
-            (int64_t)(((uint64_t)1U << ey) | (splitmix64(state) & (((uint64_t)1U << ey) - 1U)));
+        const int64_t my = (int64_t)(((uint64_t)1U << ey) | (splitmix64(state) & (((uint64_t)1U << ey) - 1U)));
         *x = (bits >> 63) != 0U ? -mx : mx;
         *y = ((bits >> 62) & 1U) != 0U ? -my : my;
         break;
@@ -89,12 +85,30 @@ static double atan2_worst(uint64_t seed, uint32_t n)
 {
     const int64_t g = (int64_t)1 << 62;
     static const int64_t edges[][2] = {
-        {0, 0}, {1, 0}, {0, -1}, {1, 1}, {-1, -1}, {-1, 0}, {0, 1}, {1, -1}, {-1, 1},
-        {INT64_MAX, INT64_MAX}, {INT64_MIN, INT64_MIN},
-        {INT64_MIN, INT64_MAX}, {INT64_MAX, INT64_MIN},
-        {INT64_MIN, 0}, {0, INT64_MIN}, {INT64_MAX, 0}, {0, INT64_MAX}, {INT64_MIN, INT64_MIN + 1},
-        {INT64_MAX, INT64_MAX - 1}, {INT64_MAX - 1, INT64_MAX}, {1, INT64_MAX}, {-1, INT64_MIN},
-        {INT64_MAX, 1}, {INT64_MIN, -1},
+        {0, 0},
+        {1, 0},
+        {0, -1},
+        {1, 1},
+        {-1, -1},
+        {-1, 0},
+        {0, 1},
+        {1, -1},
+        {-1, 1},
+        {INT64_MAX, INT64_MAX},
+        {INT64_MIN, INT64_MIN},
+        {INT64_MIN, INT64_MAX},
+        {INT64_MAX, INT64_MIN},
+        {INT64_MIN, 0},
+        {0, INT64_MIN},
+        {INT64_MAX, 0},
+        {0, INT64_MAX},
+        {INT64_MIN, INT64_MIN + 1},
+        {INT64_MAX, INT64_MAX - 1},
+        {INT64_MAX - 1, INT64_MAX},
+        {1, INT64_MAX},
+        {-1, INT64_MIN},
+        {INT64_MAX, 1},
+        {INT64_MIN, -1},
     };
     double worst = 0.0;
     for (size_t i = 0; i < sizeof edges / sizeof edges[0]; i++) {
@@ -115,8 +129,7 @@ static double atan2_worst(uint64_t seed, uint32_t n)
     return worst;
 }
 
-void odo_trig_accuracy(uint64_t seed, uint32_t n, double *sincos_max_abs_err,
-                       double *atan2_max_abs_err_rad)
+void odo_trig_accuracy(uint64_t seed, uint32_t n, double *sincos_max_abs_err, double *atan2_max_abs_err_rad)
 {
     if (sincos_max_abs_err != NULL) {
         *sincos_max_abs_err = sincos_worst(seed, n);

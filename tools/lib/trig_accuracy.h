@@ -18,7 +18,6 @@
 ///                        [-pi, pi]. May be NULL to skip atan2.
 ///
 /// Cost: about 3n libm calls for each measured family. Pure apart from the outputs; reentrant.
-void odo_trig_accuracy(uint64_t seed, uint32_t n, double *sincos_max_abs_err,
-                       double *atan2_max_abs_err_rad);
+void odo_trig_accuracy(uint64_t seed, uint32_t n, double *sincos_max_abs_err, double *atan2_max_abs_err_rad);
 
 #endif

@@ -1,6 +1,6 @@
 /// odo-params: write and inspect the firmware parameter block (odo/odo_params.h).
 ///
-///   odo-params defaults --out FILE   write the default block (FILE.tmp, fsync, rename)
+///   odo-params defaults --out FILE   write the default block (temp beside FILE, fsync, rename)
 ///   odo-params show FILE             decode FILE (version 1 or 2) and print every field as JSON
 ///   odo-params layout [--out FILE]   the header's field table (ODO_PARAMS_FIELDS) as JSON
 ///
@@ -20,6 +20,8 @@
 #include <unistd.h>
 
 #include "odo/odo_params.h"
+#include "odo_cli.h"
+#include "odo_out.h"
 #include "params_diag.h"
 #include "params_json.h"
 
@@ -44,9 +46,9 @@ static void usage_main(FILE *f)
             "  show FILE             decode FILE, print every field as one JSON object\n"
             "  layout [--out FILE]   print the block's field table (offsets, widths, ranges) as JSON\n"
             "\n"
-            "Run '%s <command> --help' for a command's options.\n"
+            "Run '%s <command> --help' for a command's options; '%s --version' prints the version.\n"
             "Exit status: 0 ok, 1 rejected block or I/O error, 2 usage error.\n",
-            k_prog, ODO_PARAMS_SIZE, ODO_PARAMS_VERSION, ODO_PARAMS_V1_SIZE, k_prog);
+            k_prog, ODO_PARAMS_SIZE, ODO_PARAMS_VERSION, ODO_PARAMS_V1_SIZE, k_prog, k_prog);
 }
 
 static void usage_defaults(FILE *f)
@@ -55,8 +57,9 @@ static void usage_defaults(FILE *f)
             "usage: %s defaults --out FILE\n"
             "\n"
             "Write the documented default parameter block (odo_params_defaults) to FILE.\n"
-            "The block is written to FILE.tmp, flushed to disk and renamed over FILE, so FILE is\n"
-            "either the old content or the complete new block; on error nothing is left behind.\n"
+            "The block is written to a fresh temp file beside FILE, flushed to disk and renamed over\n"
+            "FILE, so FILE is either the old content or the complete new block; on error nothing is\n"
+            "left behind. Missing folders are created; FILE must not be a folder, link or device.\n"
             "\n"
             "options:\n"
             "  -o, --out FILE   output file (required)\n"
@@ -89,7 +92,7 @@ static void usage_layout(FILE *f)
             "firmware/include/odo/odo_params.h, as one JSON object: header, sizes and CRC offsets\n"
             "of every version, and per field its JSON name, scope, offsets (one per truck for truck\n"
             "fields), width, type, signedness, range, unit and the version that introduced it.\n"
-            "With --out, write it to FILE.tmp and rename it over FILE.\n"
+            "With --out, write it to a temp file beside FILE and rename it over FILE.\n"
             "\n"
             "options:\n"
             "  -o, --out FILE   output file (default: stdout)\n"
@@ -102,64 +105,17 @@ static bool is_help(const char *a) { return strcmp(a, "-h") == 0 || strcmp(a, "-
 /* ---------------------------------------------------------------------------------------------
  * defaults
  * ------------------------------------------------------------------------------------------- */
-static int write_all(int fd, const uint8_t *b, size_t n)
-{
-    while (n > 0) {
-        ssize_t w = write(fd, b, n);
-        if (w < 0) {
-            if (errno == EINTR) {
-                continue;
-            }
-            return -1;
-        }
-        b += (size_t)w;
-        n -= (size_t)w;
-    }
-    return 0;
-}
-
-/// Write b to path atomically: path.tmp, fsync, rename. On failure, no path.tmp remains.
+/// Write b to path by hostlib/odo_out.h's rule: a fresh temp beside it (O_EXCL|O_NOFOLLOW, so a
+/// symlink planted at any temp name is never followed), fsync, rename; a FIFO, device, folder or
+/// symlink at path is refused. On failure nothing is left behind.
 static int write_file_atomic(const char *path, const uint8_t *b, size_t n)
 {
-    size_t plen = strlen(path);
-    char *tmp = malloc(plen + sizeof ".tmp");
-    if (tmp == NULL) {
-        fprintf(stderr, "%s: out of memory\n", k_prog);
+    char err[4096 + 256];
+    if (odo_out_write(path, b, n, NULL, err, sizeof err) != 0) {
+        fprintf(stderr, "%s: %s\n", k_prog, err);
         return -1;
     }
-    memcpy(tmp, path, plen);
-    memcpy(tmp + plen, ".tmp", sizeof ".tmp");
-
-    int fd = open(tmp, O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    if (fd < 0) {
-        fprintf(stderr, "%s: cannot create %s: %s\n", k_prog, tmp, strerror(errno));
-        free(tmp);
-        return -1;
-    }
-    const char *step = "write";
-    int rc = write_all(fd, b, n);
-    if (rc == 0) {
-        step = "fsync";
-        rc = fsync(fd);
-    }
-    int saved = errno;
-    if (close(fd) != 0 && rc == 0) {
-        step = "close";
-        rc = -1;
-        saved = errno;
-    }
-    if (rc == 0) {
-        step = "rename";
-        rc = rename(tmp, path);
-        saved = errno;
-    }
-    if (rc != 0) {
-        fprintf(stderr, "%s: cannot %s %s: %s\n", k_prog, step,
-                strcmp(step, "rename") == 0 ? path : tmp, strerror(saved));
-        (void)unlink(tmp);
-    }
-    free(tmp);
-    return rc;
+    return 0;
 }
 
 static int cmd_defaults(int argc, char **argv)
@@ -247,8 +203,9 @@ static void print_json(FILE *f, const char *path, const uint8_t *b, const odo_pa
     const size_t crc_off = odo_params_version_size(le16(&b[4])) - 4U;
     fprintf(f, "{\"file\": ");
     json_str(f, path);
-    fprintf(f, ", \"status\": \"ok\", \"magic\": \"ODOP\", \"version\": %u, \"length\": %u, "
-               "\"crc32\": \"0x%08" PRIX32 "\",\n",
+    fprintf(f,
+            ", \"status\": \"ok\", \"magic\": \"ODOP\", \"version\": %u, \"length\": %u, "
+            "\"crc32\": \"0x%08" PRIX32 "\",\n",
             (unsigned)le16(&b[4]), (unsigned)le16(&b[6]), le32(&b[crc_off]));
     odo_params_json_fields(f, p, le16(&b[4]));
     fputs("}\n", f);
@@ -300,8 +257,7 @@ static int cmd_show(int argc, char **argv)
         return EXIT_REJECTED;
     }
     if (n > MAX_INPUT_BYTES) {
-        fprintf(stderr, "%s: %s: larger than %lu bytes, not a parameter block\n", k_prog, path,
-                MAX_INPUT_BYTES);
+        fprintf(stderr, "%s: %s: larger than %lu bytes, not a parameter block\n", k_prog, path, MAX_INPUT_BYTES);
         free(buf);
         return EXIT_REJECTED;
     }
@@ -346,39 +302,46 @@ static const char *scope_key(const char *scope)
 
 static void print_layout(FILE *f)
 {
-    fprintf(f, "{\"magic\": \"ODOP\", \"magic_u32\": %lu, \"version\": %u, \"size\": %u, "
-               "\"crc_offset\": %u, \"header_size\": %u, \"trucks\": %u,\n",
+    fprintf(f,
+            "{\"magic\": \"ODOP\", \"magic_u32\": %lu, \"version\": %u, \"size\": %u, "
+            "\"crc_offset\": %u, \"header_size\": %u, \"trucks\": %u,\n",
             (unsigned long)ODO_PARAMS_MAGIC, ODO_PARAMS_VERSION, ODO_PARAMS_SIZE, ODO_PARAMS_CRC_OFFSET,
             ODO_PARAMS_HEADER_SIZE, (unsigned)ODO_TRUCKS);
     fputs(" \"versions\": [", f);
     for (unsigned v = 1U; v <= ODO_PARAMS_VERSION; ++v) {
         const size_t size = odo_params_version_size((uint16_t)v);
-        fprintf(f, "%s{\"version\": %u, \"size\": %zu, \"crc_offset\": %zu}", v == 1U ? "" : ", ", v, size,
-                size - 4U);
+        fprintf(f, "%s{\"version\": %u, \"size\": %zu, \"crc_offset\": %zu}", v == 1U ? "" : ", ", v, size, size - 4U);
     }
     fputs("],\n \"header\": [{\"name\": \"magic\", \"offset\": 0, \"width\": 4, \"type\": \"u32\"}, "
           "{\"name\": \"version\", \"offset\": 4, \"width\": 2, \"type\": \"u16\"}, "
           "{\"name\": \"length\", \"offset\": 6, \"width\": 2, \"type\": \"u16\"}],\n"
-          " \"checks\": [\"link.length_min_um < link.length_max_um\"],\n \"fields\": [", f);
+          " \"checks\": [\"link.length_min_um < link.length_max_um\"],\n \"fields\": [",
+          f);
     const char *sep = "\n  ";
     /* Straight from the X-macro: every column as written in odo_params.h. */
-#define LAYOUT_ROW(id, scope, member, json, since, off, stride, type, lo, hi, unit)                         \
-    do {                                                                                                  \
-        const odo_param_field_info_t *fi = odo_params_field_info(ODO_PF_##id);                              \
-        fprintf(f, "%s{\"id\": \"%s\", \"name\": \"%s\", \"scope\": \"%s\", \"member\": \"%s\", "                \
-                   "\"since\": %d, \"offsets\": [%d", sep, #id, json, scope_key(#scope), #member, since, off);   \
-        if (strcmp(#scope, "TRUCK") == 0) {                                                               \
-            for (unsigned t = 1U; t < ODO_TRUCKS; ++t) {                                                  \
-                fprintf(f, ", %d", (off) + (int)t * (stride));                                              \
-            }                                                                                             \
-        }                                                                                                 \
-        fprintf(f, "], \"width\": %u, \"type\": \"%s\", \"signed\": %s, \"min\": %" PRId64                \
-                   ", \"max\": %" PRId64 ", \"unit\": \"%s\", \"enum\": %u}",                                    \
-                fi->width, strcmp(#type, "I32") == 0 ? "i32" : strcmp(#type, "U32") == 0 ? "u32"            \
-                                                      : strcmp(#type, "U16") == 0 ? "u16" : "u8",           \
-                strcmp(#type, "I32") == 0 ? "true" : "false", (int64_t)(lo), (int64_t)(hi), unit,          \
-                (unsigned)ODO_PF_##id);                                                                   \
-        sep = ",\n  ";                                                                                    \
+#define LAYOUT_ROW(id, scope, member, json, since, off, stride, type, lo, hi, unit)                           \
+    do {                                                                                                      \
+        const odo_param_field_info_t *fi = odo_params_field_info(ODO_PF_##id);                                \
+        fprintf(f,                                                                                            \
+                "%s{\"id\": \"%s\", \"name\": \"%s\", \"scope\": \"%s\", \"member\": \"%s\", "                \
+                "\"since\": %d, \"offsets\": [%d",                                                            \
+                sep, #id, json, scope_key(#scope), #member, since, off);                                      \
+        if (strcmp(#scope, "TRUCK") == 0) {                                                                   \
+            for (unsigned t = 1U; t < ODO_TRUCKS; ++t) {                                                      \
+                fprintf(f, ", %d", (off) + (int)t * (stride));                                                \
+            }                                                                                                 \
+        }                                                                                                     \
+        fprintf(f,                                                                                            \
+                "], \"width\": %u, \"type\": \"%s\", \"signed\": %s, \"min\": %" PRId64 ", \"max\": %" PRId64 \
+                ", \"unit\": \"%s\", \"enum\": %u}",                                                          \
+                fi->width,                                                                                    \
+                strcmp(#type, "I32") == 0   ? "i32"                                                           \
+                : strcmp(#type, "U32") == 0 ? "u32"                                                           \
+                : strcmp(#type, "U16") == 0 ? "u16"                                                           \
+                                            : "u8",                                                           \
+                strcmp(#type, "I32") == 0 ? "true" : "false", (int64_t)(lo), (int64_t)(hi), unit,             \
+                (unsigned)ODO_PF_##id);                                                                       \
+        sep = ",\n  ";                                                                                        \
     } while (0);
     ODO_PARAMS_FIELDS(LAYOUT_ROW)
 #undef LAYOUT_ROW
@@ -428,6 +391,10 @@ int main(int argc, char **argv)
     if (argc < 2) {
         usage_main(stderr);
         return EXIT_USAGE;
+    }
+    if (strcmp(argv[1], "--version") == 0) {
+        odo_cli_print_version(k_prog);
+        return 0;
     }
     if (is_help(argv[1])) {
         usage_main(stdout);

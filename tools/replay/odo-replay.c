@@ -1,14 +1,14 @@
 /// odo-replay: run the firmware's 40 ms application step on recorded or live CAN sensor frames.
 ///
-///   offline: odo-replay --log run.log --robot R.json [--params P.bin|P.json] [--ipec on|off] --out DIR
+///   offline: odo-replay --log run.log --robot R.json [--params P.bin|P.json] [--ipec MODE] --out DIR
 ///   live:    odo-replay --iface vcan0 --robot R.json ... [--out DIR] [--idle-exit S] [--no-send]
 ///
 /// Both modes feed the same tick assembler (replay.h), so the same frames give the same outputs.
 /// DIR receives poses.csv, out.log (the firmware's output frames, candump -l) and summary.json,
-/// written to DIR.tmp.<pid> and renamed into place at the end: nothing half-written.
+/// built in a temp folder beside DIR and put into place at the end (hostlib/odo_out.h).
 #define _DEFAULT_SOURCE 1
-#include <dirent.h>
 #include <errno.h>
+#include <getopt.h>
 #include <inttypes.h>
 #include <limits.h>
 #include <math.h>
@@ -23,57 +23,61 @@
 
 #include "hal_log.h"
 #include "hal_socketcan.h"
+#include "odo_cli.h"
+#include "odo_out.h"
 #include "odo/odo_can.h"
 #include "odo/odo_params.h"
 #include "params_json.h"
 #include "replay.h"
 #include "robot.h"
 
-#define MARKER ".odo-replay"
 #define PROGRESS_TICKS 25000U
 
 static void usage(FILE *f)
 {
-    fprintf(f,
-            "usage: odo-replay --log RUN.log  (--robot R.json | --params P) [options] --out DIR\n"
-            "       odo-replay --iface vcan0  (--robot R.json | --params P) [options] [--out DIR]\n"
-            "\n"
-            "Runs the firmware's 40 ms step on CAN sensor frames (WHEEL_COUNTS_A/B, LINK_ROTARY,\n"
-            "LINK_LINEAR; can/odometry.dbc) read from a candump -l log or a SocketCAN interface,\n"
-            "on the frames' timestamps (tick k collects the frames within half a period of\n"
-            "t0 + k * 40 ms). Live mode publishes the output frames on the interface.\n"
-            "\n"
-            "  --robot R.json     robot description (host_sim/robots/*.json) -> parameters\n"
-            "  --params P         parameter block, raw (P.bin) or JSON (P.json, odo-params show);\n"
-            "                     overrides --robot\n"
-            "  --ipec on|off      force IPEC on (paper mode, as odo-sim --ipec on) or off;\n"
-            "                     default: what the robot/parameters say (odo-sim's default is off)\n"
-            "  --out DIR          poses.csv, out.log (output frames, candump -l), summary.json\n"
-            "  --out-iface NAME   interface name written in out.log (default: the input's)\n"
-            "  --idle-exit S      live: exit S seconds after the last frame (default: run until\n"
-            "                     SIGINT/SIGTERM)\n"
-            "  --no-send          live: do not publish the output frames on the bus\n"
-            "  --margin-ms M      live: close a tick M ms after its last frame may arrive (default 5)\n"
-            "  --quiet            no progress on stderr\n"
-            "\n"
-            "Exit status: 0 done, 1 bad input (the message names file and line), 2 usage.\n");
+    fprintf(f, "usage: odo-replay --log RUN.log  (--robot R.json | --params P) [options] --out DIR\n"
+               "       odo-replay --iface vcan0  (--robot R.json | --params P) [options] [--out DIR]\n"
+               "       odo-replay --help | --version\n"
+               "\n"
+               "Runs the firmware's 40 ms step on CAN sensor frames (WHEEL_COUNTS_A/B, LINK_ROTARY,\n"
+               "LINK_LINEAR; can/odometry.dbc) read from a candump -l log or a SocketCAN interface,\n"
+               "on the frames' timestamps (tick k collects the frames within half a period of\n"
+               "t0 + k * 40 ms). Live mode publishes the output frames on the interface.\n"
+               "\n"
+               "  --robot R.json     robot description (host_sim/robots/*.json) -> parameters\n"
+               "  --params P         parameter block, raw (P.bin) or JSON (P.json, odo-params show);\n"
+               "                     overrides --robot\n"
+               "  --ipec MODE        off, on (= paper), paper or estimator, as in odo-sim;\n"
+               "                     default: what the robot/parameters say (odo-sim's default is off)\n"
+               "  --out DIR          poses.csv, out.log (output frames, candump -l), summary.json;\n"
+               "                     missing parents are created; an existing DIR must be empty or a\n"
+               "                     previous odo-replay output (.odo-manifest), unless --force\n"
+               "  --force            write into a non-empty folder odo-replay did not write (same-named\n"
+               "                     files are replaced, nothing is removed)\n"
+               "  --out-iface NAME   interface name written in out.log (default: the input's)\n"
+               "  --idle-exit S      live: exit S seconds after the last frame (default: run until\n"
+               "                     SIGINT/SIGTERM)\n"
+               "  --no-send          live: do not publish the output frames on the bus\n"
+               "  --margin-ms M      live: close a tick M ms after its last frame may arrive (default 5)\n"
+               "  --quiet            no progress on stderr\n"
+               "\n"
+               "Exit status: 0 done, 1 bad input (the message names file and line), 2 usage.\n");
 }
 
 typedef struct {
-    FILE          *csv;
-    FILE          *log;
-    char           iface[CANDUMP_IFACE_MAX + 1];
-    hal_socketcan_t *sc;      ///< live: publish here (NULL: offline or --no-send)
-    int            quiet;
-    int            io_error;
-    uint64_t       out_frames;
+    FILE *csv;
+    FILE *log;
+    char iface[CANDUMP_IFACE_MAX + 1];
+    hal_socketcan_t *sc; ///< live: publish here (NULL: offline or --no-send)
+    int quiet;
+    int io_error;
+    uint64_t out_frames;
 } sink_t;
 
 static double q32_mm(int64_t v) { return (double)v / 4294967296.0; }
 static double q64_deg(uint64_t h) { return ldexp((double)h, -64) * 360.0; }
 
-static void on_tick(void *user, replay_t *r, uint64_t tick, const odo_tick_input_t *in,
-                    const odo_tick_output_t *out)
+static void on_tick(void *user, replay_t *r, uint64_t tick, const odo_tick_input_t *in, const odo_tick_output_t *out)
 {
     sink_t *s = user;
     char line[CANDUMP_LINE_MAX];
@@ -88,12 +92,12 @@ static void on_tick(void *user, replay_t *r, uint64_t tick, const odo_tick_input
     const odo_pose_t *a = &out->pose[ODO_TRUCK_A], *b = &out->pose[ODO_TRUCK_B];
     /* t_s: the tick's time on the log's clock relative to the first tick (steps back after a
      * clock step, jumps over a skipped gap; replay.h). */
-    const double t_s = in->t_us >= r->origin_us ? (double)(in->t_us - r->origin_us) / 1e6
-                                                : -(double)(r->origin_us - in->t_us) / 1e6;
-    fprintf(s->csv, "%" PRIu64 ",%.6f,%.6f,%.6f,%.9f,%.6f,%.6f,%.9f,%" PRId32 ",%" PRId32 ",0x%05" PRIX32 "\n",
-            tick, t_s, q32_mm(a->x_mm_q32), q32_mm(a->y_mm_q32),
-            q64_deg(a->heading_q64), q32_mm(b->x_mm_q32), q32_mm(b->y_mm_q32), q64_deg(b->heading_q64),
-            out->ipec_dtheta_bam[0], out->ipec_dtheta_bam[1], out->faults);
+    const double t_s =
+        in->t_us >= r->origin_us ? (double)(in->t_us - r->origin_us) / 1e6 : -(double)(r->origin_us - in->t_us) / 1e6;
+    fprintf(s->csv, "%" PRIu64 ",%.6f,%.6f,%.6f,%.9f,%.6f,%.6f,%.9f,%" PRId32 ",%" PRId32 ",0x%05" PRIX32 "\n", tick,
+            t_s, q32_mm(a->x_mm_q32), q32_mm(a->y_mm_q32), q64_deg(a->heading_q64), q32_mm(b->x_mm_q32),
+            q32_mm(b->y_mm_q32), q64_deg(b->heading_q64), out->ipec_dtheta_bam[0], out->ipec_dtheta_bam[1],
+            out->faults);
     if (!s->quiet && tick > 0U && tick % PROGRESS_TICKS == 0U) {
         fprintf(stderr, "odo-replay: %" PRIu64 " ticks (%.0f s of log)\n", tick, t_s);
     }
@@ -125,42 +129,6 @@ static int load_params(const char *robot, const char *params, odo_params_t *p)
     return 0;
 }
 
-/// Remove a folder holding only files (our own outputs).
-static void remove_flat_dir(const char *dir)
-{
-    DIR *d = opendir(dir);
-    if (d != NULL) {
-        char path[PATH_MAX];
-        for (struct dirent *e; (e = readdir(d)) != NULL;) {
-            if (strcmp(e->d_name, ".") != 0 && strcmp(e->d_name, "..") != 0) {
-                snprintf(path, sizeof path, "%s/%s", dir, e->d_name);
-                remove(path);
-            }
-        }
-        closedir(d);
-    }
-    rmdir(dir);
-}
-
-/// DIR may be replaced only if it does not exist or holds a previous odo-replay output.
-static int out_dir_ok(const char *dir)
-{
-    struct stat sb;
-    if (stat(dir, &sb) != 0) {
-        return 1;
-    }
-    char marker[PATH_MAX];
-    snprintf(marker, sizeof marker, "%s/" MARKER, dir);
-    return S_ISDIR(sb.st_mode) && access(marker, F_OK) == 0;
-}
-
-static FILE *open_in(const char *dir, const char *name)
-{
-    char path[PATH_MAX];
-    snprintf(path, sizeof path, "%s/%s", dir, name);
-    return fopen(path, "w");
-}
-
 /// A JSON string for any bytes: jansson refuses invalid UTF-8, so such a path is written with '?'
 /// for every byte above 0x7F (the summary stays valid JSON; the file names the input anyway).
 static json_t *json_path(const char *s)
@@ -185,8 +153,8 @@ static int set_u64(json_t *o, const char *key, uint64_t v)
 }
 
 /// summary.json, built with jansson so every string is escaped. Returns 0, or -1 on a write error.
-static int write_summary(FILE *f, const char *mode, const char *input, const replay_t *r,
-                         const hal_log_stats_t *ls, const hal_sc_stats_t *ss, const sink_t *s)
+static int write_summary(FILE *f, const char *mode, const char *input, const replay_t *r, const hal_log_stats_t *ls,
+                         const hal_sc_stats_t *ss, const sink_t *s)
 {
     const replay_stats_t *st = &r->stats;
     json_t *o = json_object();
@@ -246,8 +214,10 @@ static void report_gaps(const replay_t *r, uint64_t *seen, const char *where)
     if (*seen > GAP_REPORTS) {
         return;
     }
-    fprintf(stderr, "odo-replay: %s: a gap of %.6g s in the frames (more than %u ticks): skipped, not stepped "
-                    "through%s\n", where, (double)r->stats.last_gap_us / 1e6, REPLAY_MAX_GAP_TICKS,
+    fprintf(stderr,
+            "odo-replay: %s: a gap of %.6g s in the frames (more than %u ticks): skipped, not stepped "
+            "through%s\n",
+            where, (double)r->stats.last_gap_us / 1e6, REPLAY_MAX_GAP_TICKS,
             *seen == GAP_REPORTS ? " (further gaps only in summary.json)" : "");
 }
 
@@ -336,50 +306,75 @@ int main(int argc, char **argv)
 {
     const char *log = NULL, *iface = NULL, *robot = NULL, *params = NULL, *out = NULL, *out_iface = NULL;
     int ipec = -1, quiet = 0, no_send = 0;
+    bool force = false;
     double idle_exit_s = 0.0, margin_ms = 5.0;
-    for (int i = 1; i < argc; ++i) {
-        const char *a = argv[i];
-        const int has = i + 1 < argc;
-        if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
-            usage(stdout);
-            return 0;
-        } else if (strcmp(a, "--quiet") == 0) {
-            quiet = 1;
-        } else if (strcmp(a, "--no-send") == 0) {
-            no_send = 1;
-        } else if (has && strcmp(a, "--log") == 0) {
-            log = argv[++i];
-        } else if (has && strcmp(a, "--iface") == 0) {
-            iface = argv[++i];
-        } else if (has && strcmp(a, "--robot") == 0) {
-            robot = argv[++i];
-        } else if (has && strcmp(a, "--params") == 0) {
-            params = argv[++i];
-        } else if (has && strcmp(a, "--out") == 0) {
-            out = argv[++i];
-        } else if (has && strcmp(a, "--out-iface") == 0) {
-            out_iface = argv[++i];
-        } else if (has && strcmp(a, "--ipec") == 0) {
-            ++i;
-            if (strcmp(argv[i], "on") != 0 && strcmp(argv[i], "off") != 0) {
-                fprintf(stderr, "odo-replay: --ipec must be on or off, not '%s'\n", argv[i]);
+    enum {
+        O_LOG = 256,
+        O_IFACE,
+        O_ROBOT,
+        O_PARAMS,
+        O_OUT,
+        O_OUT_IFACE,
+        O_IPEC,
+        O_IDLE,
+        O_MARGIN,
+        O_NO_SEND,
+        O_FORCE,
+        O_QUIET,
+        O_VERSION
+    };
+    static const struct option longopts[] = {{"log", required_argument, NULL, O_LOG},
+                                             {"iface", required_argument, NULL, O_IFACE},
+                                             {"robot", required_argument, NULL, O_ROBOT},
+                                             {"params", required_argument, NULL, O_PARAMS},
+                                             {"out", required_argument, NULL, O_OUT},
+                                             {"out-iface", required_argument, NULL, O_OUT_IFACE},
+                                             {"ipec", required_argument, NULL, O_IPEC},
+                                             {"idle-exit", required_argument, NULL, O_IDLE},
+                                             {"margin-ms", required_argument, NULL, O_MARGIN},
+                                             {"no-send", no_argument, NULL, O_NO_SEND},
+                                             {"force", no_argument, NULL, O_FORCE},
+                                             {"quiet", no_argument, NULL, O_QUIET},
+                                             {"version", no_argument, NULL, O_VERSION},
+                                             {"help", no_argument, NULL, 'h'},
+                                             {NULL, 0, NULL, 0}};
+    for (int c; (c = getopt_long(argc, argv, "h", longopts, NULL)) != -1;) {
+        switch (c) {
+        case 'h': usage(stdout); return 0;
+        case O_VERSION: odo_cli_print_version("odo-replay"); return 0;
+        case O_LOG: log = optarg; break;
+        case O_IFACE: iface = optarg; break;
+        case O_ROBOT: robot = optarg; break;
+        case O_PARAMS: params = optarg; break;
+        case O_OUT: out = optarg; break;
+        case O_OUT_IFACE: out_iface = optarg; break;
+        case O_IPEC:
+            if ((ipec = odo_cli_ipec("odo-replay", optarg)) < 0) {
                 return 2;
             }
-            ipec = strcmp(argv[i], "on") == 0;
-        } else if (has && (strcmp(a, "--idle-exit") == 0 || strcmp(a, "--margin-ms") == 0)) {
+            break;
+        case O_IDLE:
+        case O_MARGIN: {
             char *end = NULL;
-            const double v = strtod(argv[++i], &end);
-            if (end == argv[i] || *end != '\0' || !(v >= 0.0) || v > 86400.0) {
-                fprintf(stderr, "odo-replay: %s needs a number of %s >= 0, not '%s'\n", a,
-                        a[2] == 'i' ? "seconds" : "milliseconds", argv[i]);
+            const double v = strtod(optarg, &end);
+            if (end == optarg || *end != '\0' || !(v >= 0.0) || v > 86400.0) {
+                fprintf(stderr, "odo-replay: %s needs a number of %s >= 0, not '%s'\n",
+                        c == O_IDLE ? "--idle-exit" : "--margin-ms", c == O_IDLE ? "seconds" : "milliseconds", optarg);
                 return 2;
             }
-            *(a[2] == 'i' ? &idle_exit_s : &margin_ms) = v;
-        } else {
-            fprintf(stderr, "odo-replay: unknown or incomplete argument '%s'\n\n", a);
-            usage(stderr);
-            return 2;
+            *(c == O_IDLE ? &idle_exit_s : &margin_ms) = v;
+            break;
         }
+        case O_NO_SEND: no_send = 1; break;
+        case O_FORCE: force = true; break;
+        case O_QUIET: quiet = 1; break;
+        default: odo_cli_usage_hint("odo-replay"); return 2;
+        }
+    }
+    if (optind < argc) {
+        fprintf(stderr, "odo-replay: unexpected argument '%s'\n", argv[optind]);
+        odo_cli_usage_hint("odo-replay");
+        return 2;
     }
     if ((log == NULL) == (iface == NULL)) {
         fprintf(stderr, "odo-replay: give exactly one of --log FILE and --iface NAME\n\n");
@@ -394,17 +389,13 @@ int main(int argc, char **argv)
         fprintf(stderr, "odo-replay: --out DIR is required with --log\n");
         return 2;
     }
-    if (out != NULL && !out_dir_ok(out)) {
-        fprintf(stderr, "odo-replay: %s exists and is not an odo-replay output; not replacing it\n", out);
-        return 2;
-    }
 
     odo_params_t p;
     if (load_params(robot, params, &p) != 0) {
         return 1;
     }
     if (ipec >= 0) {
-        p.ipec_mode = (uint8_t)(ipec ? ODO_IPEC_PAPER : ODO_IPEC_OFF);
+        p.ipec_mode = (uint8_t)(ipec == 2 ? ODO_IPEC_ESTIMATOR : ipec == 1 ? ODO_IPEC_PAPER : ODO_IPEC_OFF);
     }
 
     /* Inputs first: a missing log or interface fails before anything is created. */
@@ -422,36 +413,45 @@ int main(int argc, char **argv)
         return 1;
     }
 
-    char tmp[PATH_MAX] = "";
+    odo_out_dir_t *dir = NULL;
+    char oerr[PATH_MAX + 256];
     sink_t sink;
     memset(&sink, 0, sizeof sink);
     sink.quiet = quiet;
     sink.sc = (iface != NULL && !no_send) ? &sc : NULL;
     snprintf(sink.iface, sizeof sink.iface, "%s", out_iface != NULL ? out_iface : (iface != NULL ? iface : "can0"));
+    snprintf(oerr, sizeof oerr, "/dev/null: %s", "cannot open");
     if (out != NULL) {
-        snprintf(tmp, sizeof tmp, "%s.tmp.%ld", out, (long)getpid());
-        if (mkdir(tmp, 0777) != 0) {
-            fprintf(stderr, "odo-replay: cannot create %s: %s\n", tmp, strerror(errno));
+        /* The log, the robot and the block are inputs: no --out may touch them. */
+        odo_out_inputs_t ins;
+        odo_out_inputs_init(&ins);
+        (void)odo_out_inputs_add(&ins, log, oerr, sizeof oerr);
+        (void)odo_out_inputs_add(&ins, robot, oerr, sizeof oerr);
+        (void)odo_out_inputs_add(&ins, params, oerr, sizeof oerr);
+        dir = odo_out_dir_begin(out, "odo-replay", force, &ins, oerr, sizeof oerr);
+        if (dir == NULL) {
+            fprintf(stderr, "odo-replay: %s\n", oerr);
+            hal_log_close(&reader);
+            hal_socketcan_close(&sc);
             return 1;
         }
-        sink.csv = open_in(tmp, "poses.csv");
-        sink.log = open_in(tmp, "out.log");
+        sink.csv = odo_out_dir_fopen(dir, "poses.csv", oerr, sizeof oerr);
+        sink.log = sink.csv != NULL ? odo_out_dir_fopen(dir, "out.log", oerr, sizeof oerr) : NULL;
     } else {
         sink.csv = fopen("/dev/null", "w");
         sink.log = fopen("/dev/null", "w");
     }
     if (sink.csv == NULL || sink.log == NULL) {
-        fprintf(stderr, "odo-replay: cannot create outputs in %s: %s\n", out != NULL ? tmp : "/dev/null",
-                strerror(errno));
+        fprintf(stderr, "odo-replay: %s\n", oerr);
         if (sink.csv != NULL) {
             fclose(sink.csv);
         }
         if (sink.log != NULL) {
             fclose(sink.log);
         }
-        if (out != NULL) {
-            remove_flat_dir(tmp); /* ours: nothing half-written stays behind */
-        }
+        odo_out_dir_abort(dir); /* ours: nothing half-written stays behind */
+        hal_log_close(&reader);
+        hal_socketcan_close(&sc);
         return 1;
     }
     static char csv_buf[1 << 16], log_buf[1 << 16];
@@ -494,60 +494,62 @@ int main(int argc, char **argv)
         replay_finish(&r);
     }
     if (r.stats.time_backwards > 0U && !quiet) {
-        fprintf(stderr, "odo-replay: warning: %" PRIu64 " frames stamped before the previous frame "
-                        "(flagged TIME_BACKWARDS)\n", r.stats.time_backwards);
+        fprintf(stderr,
+                "odo-replay: warning: %" PRIu64 " frames stamped before the previous frame "
+                "(flagged TIME_BACKWARDS)\n",
+                r.stats.time_backwards);
     }
     if (r.stats.clock_steps > 0U && !quiet) {
-        fprintf(stderr, "odo-replay: warning: the clock stepped back %" PRIu64 " time(s) by more than %u ticks; "
-                        "the tick clock was re-anchored each time\n", r.stats.clock_steps, REPLAY_CLOCK_STEP_TICKS);
+        fprintf(stderr,
+                "odo-replay: warning: the clock stepped back %" PRIu64 " time(s) by more than %u ticks; "
+                "the tick clock was re-anchored each time\n",
+                r.stats.clock_steps, REPLAY_CLOCK_STEP_TICKS);
     }
     if (r.stats.gaps > 0U) { /* reported even with --quiet: the output has a hole */
-        fprintf(stderr, "odo-replay: warning: %" PRIu64 " gap(s) longer than %u ticks skipped, %.6g s in all "
-                        "(longest %.6g s)\n", r.stats.gaps, REPLAY_MAX_GAP_TICKS, (double)r.stats.gap_us / 1e6,
-                (double)r.stats.longest_gap_us / 1e6);
+        fprintf(stderr,
+                "odo-replay: warning: %" PRIu64 " gap(s) longer than %u ticks skipped, %.6g s in all "
+                "(longest %.6g s)\n",
+                r.stats.gaps, REPLAY_MAX_GAP_TICKS, (double)r.stats.gap_us / 1e6, (double)r.stats.longest_gap_us / 1e6);
     }
     if (log != NULL && reader.stats.fd_skipped > 0U && !quiet) {
         fprintf(stderr, "odo-replay: %" PRIu64 " CAN FD lines (another node's traffic) skipped\n",
                 reader.stats.fd_skipped);
     }
     if (r.stats.ignored > 0U && !quiet) {
-        fprintf(stderr, "odo-replay: %" PRIu64 " frames not consumed (unknown ID, RTR, extended or output "
-                        "frames) ignored\n", r.stats.ignored);
+        fprintf(stderr,
+                "odo-replay: %" PRIu64 " frames not consumed (unknown ID, RTR, extended or output "
+                "frames) ignored\n",
+                r.stats.ignored);
     }
 
     if (out != NULL) {
-        FILE *sf = open_in(tmp, "summary.json");
-        FILE *mk = open_in(tmp, MARKER);
+        FILE *sf = odo_out_dir_fopen(dir, "summary.json", oerr, sizeof oerr);
         int sum_bad = 0;
         if (sf != NULL) {
             sum_bad = write_summary(sf, log != NULL ? "offline" : "live", log != NULL ? log : iface, &r,
                                     log != NULL ? &reader.stats : NULL, iface != NULL ? &sc.stats : NULL, &sink);
         }
-        const int bad = sf == NULL || mk == NULL || sum_bad != 0 || fclose(sf) != 0 || fclose(mk) != 0;
+        const int bad = sf == NULL || sum_bad != 0 || fclose(sf) != 0;
         const int bad2 = fclose(sink.csv) != 0 || fclose(sink.log) != 0 || sink.io_error;
         if (rc == 0 && (bad || bad2)) {
-            fprintf(stderr, "odo-replay: writing %s failed: %s\n", tmp, strerror(errno));
+            fprintf(stderr, "odo-replay: writing %s failed: %s\n", out, sf == NULL ? oerr : strerror(errno));
             rc = 1;
         }
         if (rc == 0) {
-            if (access(out, F_OK) == 0) {
-                remove_flat_dir(out);
-            }
-            if (rename(tmp, out) != 0) {
-                fprintf(stderr, "odo-replay: cannot rename %s to %s: %s\n", tmp, out, strerror(errno));
+            if (odo_out_dir_commit(dir, oerr, sizeof oerr) != 0) {
+                fprintf(stderr, "odo-replay: %s\n", oerr);
                 rc = 1;
             }
-        }
-        if (rc != 0) {
-            remove_flat_dir(tmp);
+        } else {
+            odo_out_dir_abort(dir);
         }
     } else {
         fclose(sink.csv);
         fclose(sink.log);
     }
     if (rc == 0 && !quiet) {
-        fprintf(stderr, "odo-replay: %" PRIu64 " ticks from %" PRIu64 " frames%s%s\n", r.stats.ticks,
-                r.stats.frames, out != NULL ? " -> " : "", out != NULL ? out : "");
+        fprintf(stderr, "odo-replay: %" PRIu64 " ticks from %" PRIu64 " frames%s%s\n", r.stats.ticks, r.stats.frames,
+                out != NULL ? " -> " : "", out != NULL ? out : "");
     }
     hal_log_close(&reader);
     hal_socketcan_close(&sc);

@@ -67,21 +67,21 @@ extern "C" {
 
 /// Counters only increase.
 typedef struct {
-    uint64_t frames;          ///< frames pushed
-    uint64_t sensor_frames;   ///< accepted into a tick input
-    uint64_t ticks;           ///< steps run
-    uint64_t ignored;         ///< not consumed (unknown ID, RTR, extended, output frames)
-    uint64_t bad_dlc;         ///< consumed ID with the wrong length
-    uint64_t error_frames;    ///< error frames
-    uint64_t bus_off;         ///< error frames of the bus-off class
-    uint64_t time_backwards;  ///< frames stamped before the previous frame
-    uint64_t late;            ///< frames of a tick already closed (live jitter)
-    uint64_t dup_dropped;     ///< duplicate/stale sensor frames dropped within a tick
-    uint64_t clock_steps;     ///< backward clock steps re-anchored (also in time_backwards)
-    uint64_t gaps;            ///< gaps longer than REPLAY_MAX_GAP_TICKS skipped
-    uint64_t gap_us;          ///< time skipped over those gaps (saturating)
-    uint64_t longest_gap_us;  ///< the longest of them
-    uint64_t last_gap_us;     ///< the latest of them
+    uint64_t frames;         ///< frames pushed
+    uint64_t sensor_frames;  ///< accepted into a tick input
+    uint64_t ticks;          ///< steps run
+    uint64_t ignored;        ///< not consumed (unknown ID, RTR, extended, output frames)
+    uint64_t bad_dlc;        ///< consumed ID with the wrong length
+    uint64_t error_frames;   ///< error frames
+    uint64_t bus_off;        ///< error frames of the bus-off class
+    uint64_t time_backwards; ///< frames stamped before the previous frame
+    uint64_t late;           ///< frames of a tick already closed (live jitter)
+    uint64_t dup_dropped;    ///< duplicate/stale sensor frames dropped within a tick
+    uint64_t clock_steps;    ///< backward clock steps re-anchored (also in time_backwards)
+    uint64_t gaps;           ///< gaps longer than REPLAY_MAX_GAP_TICKS skipped
+    uint64_t gap_us;         ///< time skipped over those gaps (saturating)
+    uint64_t longest_gap_us; ///< the longest of them
+    uint64_t last_gap_us;    ///< the latest of them
 } replay_stats_t;
 
 struct replay;
@@ -92,24 +92,24 @@ typedef void (*replay_tick_fn)(void *user, struct replay *r, uint64_t tick, cons
                                const odo_tick_output_t *out);
 
 typedef struct replay {
-    odo_app_t         app;
-    uint32_t          tick_us;
-    bool              have_origin;
-    uint64_t          origin_us;  ///< t0: the first frame's time (tick 0)
-    uint64_t          anchor_us;  ///< time of tick anchor_tick (t0 and 0 until re-anchored)
-    uint64_t          anchor_tick;
-    uint64_t          cur;        ///< index of the open tick
-    bool              pending;    ///< the open tick has received a frame
-    bool              have_last;
-    uint64_t          last_t_us;  ///< timestamp of the previous frame
-    bool              seq_known[4]; ///< per sensor (WHEEL_COUNTS_A, _B, LINK_ROTARY, _LINEAR):
-    uint8_t           seq_last[4];  ///< the last sample taken, and the tick it went to
-    uint64_t          seq_tick[4];  ///< (re-anchoring after a clock step goes by them)
-    odo_tick_input_t  in;         ///< the open tick's input being assembled
+    odo_app_t app;
+    uint32_t tick_us;
+    bool have_origin;
+    uint64_t origin_us; ///< t0: the first frame's time (tick 0)
+    uint64_t anchor_us; ///< time of tick anchor_tick (t0 and 0 until re-anchored)
+    uint64_t anchor_tick;
+    uint64_t cur; ///< index of the open tick
+    bool pending; ///< the open tick has received a frame
+    bool have_last;
+    uint64_t last_t_us;   ///< timestamp of the previous frame
+    bool seq_known[4];    ///< per sensor (WHEEL_COUNTS_A, _B, LINK_ROTARY, _LINEAR):
+    uint8_t seq_last[4];  ///< the last sample taken, and the tick it went to
+    uint64_t seq_tick[4]; ///< (re-anchoring after a clock step goes by them)
+    odo_tick_input_t in;  ///< the open tick's input being assembled
     odo_tick_output_t out;
-    replay_stats_t    stats;
-    replay_tick_fn    fn;
-    void             *user;
+    replay_stats_t stats;
+    replay_tick_fn fn;
+    void *user;
 } replay_t;
 
 /// Boot the firmware app like the target and the simulator do, from the encoded parameter block

@@ -24,11 +24,11 @@
 #define BENCH_TICKS 90000UL /* one hour at 40 ms */
 
 typedef struct {
-    FILE         *f;
-    unsigned long tick;                 ///< global tick
-    uint32_t      off[ODO_TRUCKS][2];   ///< counter offset of this run
-    uint32_t      last[ODO_TRUCKS][2];  ///< raw counters at this run's last tick
-    int           io_error;
+    FILE *f;
+    unsigned long tick;           ///< global tick
+    uint32_t off[ODO_TRUCKS][2];  ///< counter offset of this run
+    uint32_t last[ODO_TRUCKS][2]; ///< raw counters at this run's last tick
+    int io_error;
 } gen_t;
 
 static void put(gen_t *g, uint64_t t_us, const odo_can_frame_t *f)
@@ -92,8 +92,14 @@ static int make_log(const char *path)
         return -1;
     }
     for (unsigned run = 0; g.tick < BENCH_TICKS; ++run) {
-        sim_run_config_t cfg = {.robot = &robot, .scenario = &sc, .experiment = "straight-36m", .ccw = 0,
-                                .bumps = -1, .bump_height_mm = 10.0, .ipec = 0, .seed = 1000U + run,
+        sim_run_config_t cfg = {.robot = &robot,
+                                .scenario = &sc,
+                                .experiment = "straight-36m",
+                                .ccw = 0,
+                                .bumps = -1,
+                                .bump_height_mm = 10.0,
+                                .ipec = 0,
+                                .seed = 1000U + run,
                                 .run_index = 0};
         sim_return_t ret;
         if (sim_run(&cfg, gen_tick, &g, &ret, err, sizeof err) != 0) {
@@ -120,13 +126,13 @@ static double now_s(void)
 {
     struct timespec ts;
     clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + ts.tv_nsec * 1e-9;
+    return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
 }
 
 typedef struct {
-    FILE    *out;
-    char     buf[1 << 16];
-    size_t   n;
+    FILE *out;
+    char buf[1 << 16];
+    size_t n;
 } sink_t;
 
 /// What odo-replay does per tick, minus the CSV: format the output frames as candump lines.
@@ -144,8 +150,8 @@ static void on_tick(void *user, replay_t *r, uint64_t tick, const odo_tick_input
     }
 }
 
-static int replay_once(const char *path, const odo_params_t *p, int with_output, double *wall_s,
-                       unsigned long *ticks, unsigned long *frames)
+static int replay_once(const char *path, const odo_params_t *p, int with_output, double *wall_s, unsigned long *ticks,
+                       unsigned long *frames)
 {
     static hal_log_t l;
     static replay_t r;
@@ -180,8 +186,8 @@ static int replay_once(const char *path, const odo_params_t *p, int with_output,
 static double python_can_rate(const char *python, const char *log, int reps)
 {
     char cmd[2048];
-    snprintf(cmd, sizeof cmd, "'%s' '%s/tools/replay/pycan_read_rate.py' --reps %d '%s'", python, ODO_SOURCE_DIR,
-             reps, log);
+    snprintf(cmd, sizeof cmd, "'%s' '%s/tools/replay/pycan_read_rate.py' --reps %d '%s'", python, ODO_SOURCE_DIR, reps,
+             log);
     FILE *p = popen(cmd, "r");
     if (p == NULL) {
         return -1.0;
@@ -241,8 +247,8 @@ int replay_bench_run(int reps, const char *python, replay_bench_t *out)
         out->python_can_frames_per_s = python_can_rate(python, out->log_path, reps > 2 ? 2 : reps);
         if (out->python_can_frames_per_s > 0.0) {
             out->ratio = out->frames_per_s / out->python_can_frames_per_s;
-            out->ipec_ratio = out->ipec_ticks_per_s * (double)out->frames / (double)out->ticks /
-                              out->python_can_frames_per_s;
+            out->ipec_ratio =
+                out->ipec_ticks_per_s * (double)out->frames / (double)out->ticks / out->python_can_frames_per_s;
         }
     }
     return 0;

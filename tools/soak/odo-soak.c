@@ -7,26 +7,27 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "odo_cli.h"
 #include "soak.h"
 
 static void usage(FILE *f)
 {
-    fprintf(f,
-            "usage: odo-soak [--json] [--quick] [--ticks N] [--seed S]\n"
-            "\n"
-            "Replays a seeded labmate drive through odo-replay's tick assembler and the firmware's\n"
-            "step twice, clean and through a faulty bus, and prints how far the faulty run's pose\n"
-            "is from the clean run's:\n"
-            "  loss   straight 40 s drives at 1, 1.6 and 2.5 m/s with 20 %% of the frames lost,\n"
-            "         10 seeds each: travel lost (target < 1 %% at 2.5 m/s)\n"
-            "  soak   24 h (2,160,000 ticks) of random driving with wheels up to 3 m/s, 20 %% lost,\n"
-            "         5 %% duplicated, 2 %% reordered, error-frame bursts and a 2 s clock step back:\n"
-            "         pose error at the end and at worst, path lost, faults flagged\n"
-            "  --json     one JSON object on stdout (progress on stderr)\n"
-            "  --quick    a 50,000-tick soak and 3 seeds per speed (smoke runs)\n"
-            "  --ticks N  soak length in ticks (default 2160000)\n"
-            "  --seed S   soak seed (default 16)\n"
-            "Exit status: 0 done, 1 a run failed, 2 usage.\n");
+    fprintf(f, "usage: odo-soak [--json] [--quick] [--ticks N] [--seed S]\n"
+               "       odo-soak --help | --version\n"
+               "\n"
+               "Replays a seeded labmate drive through odo-replay's tick assembler and the firmware's\n"
+               "step twice, clean and through a faulty bus, and prints how far the faulty run's pose\n"
+               "is from the clean run's:\n"
+               "  loss   straight 40 s drives at 1, 1.6 and 2.5 m/s with 20 %% of the frames lost,\n"
+               "         10 seeds each: travel lost (target < 1 %% at 2.5 m/s)\n"
+               "  soak   24 h (2,160,000 ticks) of random driving with wheels up to 3 m/s, 20 %% lost,\n"
+               "         5 %% duplicated, 2 %% reordered, error-frame bursts and a 2 s clock step back:\n"
+               "         pose error at the end and at worst, path lost, faults flagged\n"
+               "  --json     one JSON object on stdout (progress on stderr)\n"
+               "  --quick    a 50,000-tick soak and 3 seeds per speed (smoke runs)\n"
+               "  --ticks N  soak length in ticks (default 2160000)\n"
+               "  --seed S   soak seed (default 16)\n"
+               "Exit status: 0 done, 1 a run failed, 2 usage.\n");
 }
 
 static void on_progress(void *user, uint64_t done, uint64_t total)
@@ -52,9 +53,15 @@ int main(int argc, char **argv)
     int json = 0, quick = 0;
     soak_config_t soak;
     soak_defaults(&soak);
+    if (!odo_cli_split_equals(&argc, &argv)) {
+        return 1;
+    }
     for (int i = 1; i < argc; ++i) {
         if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
             usage(stdout);
+            return 0;
+        } else if (strcmp(argv[i], "--version") == 0) {
+            odo_cli_print_version("odo-soak");
             return 0;
         } else if (strcmp(argv[i], "--json") == 0) {
             json = 1;
@@ -124,8 +131,8 @@ int main(int argc, char **argv)
                    speeds[v] / 1000.0, seeds, dist_m[v], lost_m[v], lost_pct[v], v < 2U ? "," : "");
         }
         printf("  ],\n  \"soak\": {\n");
-        printf("    \"ticks\": %" PRIu64 ", \"hours\": %.3f, \"seed\": %" PRIu64 ", \"v_max_m_s\": %.1f,\n",
-               soak.ticks, (double)soak.ticks * 0.04 / 3600.0, soak.seed, soak.v_max_mm_s / 1000.0);
+        printf("    \"ticks\": %" PRIu64 ", \"hours\": %.3f, \"seed\": %" PRIu64 ", \"v_max_m_s\": %.1f,\n", soak.ticks,
+               (double)soak.ticks * 0.04 / 3600.0, soak.seed, soak.v_max_mm_s / 1000.0);
         printf("    \"drop\": %.2f, \"dup\": %.2f, \"reorder\": %.2f, \"burst_every_ticks\": %" PRIu64
                ", \"burst_frames\": %u, \"clock_step_s\": %.3f,\n",
                soak.drop, soak.dup, soak.reorder, soak.burst_every, soak.burst_frames,
@@ -154,8 +161,8 @@ int main(int argc, char **argv)
         }
         printf("soak %.1f h: path %.3f km; end error %.3f mm / %.6f deg; worst %.3f mm "
                "(lag while frames are missing up to %.1f mm); %" PRIu64 " counter jumps\n",
-               (double)soak.ticks * 0.04 / 3600.0, r.path_m / 1000.0, r.end_pos_err_mm,
-               r.end_heading_err_deg, r.max_pos_err_mm, r.max_lag_mm, r.fault_ticks[1]);
+               (double)soak.ticks * 0.04 / 3600.0, r.path_m / 1000.0, r.end_pos_err_mm, r.end_heading_err_deg,
+               r.max_pos_err_mm, r.max_lag_mm, r.fault_ticks[1]);
     }
     return 0;
 }

@@ -11,10 +11,10 @@
 #include "odo_synth.h"
 #include "replay.h"
 
-#define T0_US        1700000000000000ULL /* the drive's first frame: an ordinary Unix time */
-#define RING         4096U               /* clean poses kept for the lagging faulty run */
-#define CLEAN_EDGE   16U                 /* first and last ticks without faults */
-#define WIRE_MASK    0xFFFFFFU           /* 24-bit counts in WHEEL_COUNTS (can/odometry.dbc) */
+#define T0_US      1700000000000000ULL /* the drive's first frame: an ordinary Unix time */
+#define RING       4096U               /* clean poses kept for the lagging faulty run */
+#define CLEAN_EDGE 16U                 /* first and last ticks without faults */
+#define WIRE_MASK  0xFFFFFFU           /* 24-bit counts in WHEEL_COUNTS (can/odometry.dbc) */
 
 static uint64_t next_u64(uint64_t *state)
 {
@@ -72,22 +72,21 @@ static void next_segment(odo_synth_t *s, uint64_t *rng, double v_max)
 
 typedef struct {
     odo_pose_t pose[RING];
-    uint64_t   latest;     ///< last tick the clean run stepped
-    bool       any;
-    double     path_mm;
-    uint64_t   ticks;
+    uint64_t latest; ///< last tick the clean run stepped
+    bool any;
+    double path_mm;
+    uint64_t ticks;
 } clean_t;
 
 typedef struct {
     const clean_t *clean;
     soak_result_t *r;
-    uint64_t       ticks;
+    uint64_t ticks;
 } faulty_t;
 
 static double dist_mm(int64_t q40) { return fabs((double)q40) / 1099511627776.0; }
 
-static void on_clean(void *user, replay_t *rp, uint64_t tick, const odo_tick_input_t *in,
-                     const odo_tick_output_t *out)
+static void on_clean(void *user, replay_t *rp, uint64_t tick, const odo_tick_input_t *in, const odo_tick_output_t *out)
 {
     (void)rp;
     (void)in;
@@ -104,8 +103,7 @@ static double pos_err_mm(const odo_pose_t *a, const odo_pose_t *b)
     return hypot((double)(a->x_mm_q32 - b->x_mm_q32), (double)(a->y_mm_q32 - b->y_mm_q32)) / 4294967296.0;
 }
 
-static void on_faulty(void *user, replay_t *rp, uint64_t tick, const odo_tick_input_t *in,
-                      const odo_tick_output_t *out)
+static void on_faulty(void *user, replay_t *rp, uint64_t tick, const odo_tick_input_t *in, const odo_tick_output_t *out)
 {
     (void)rp;
     faulty_t *f = user;
@@ -127,7 +125,7 @@ static void on_faulty(void *user, replay_t *rp, uint64_t tick, const odo_tick_in
 
 typedef struct {
     odo_can_frame_t f;
-    uint64_t        t_us;
+    uint64_t t_us;
 } tframe_t;
 
 int soak_run(const soak_config_t *c, soak_result_t *r, soak_progress_fn progress, void *user)
@@ -196,8 +194,8 @@ int soak_run(const soak_config_t *c, soak_result_t *r, soak_progress_fn progress
         bool lost = false;
         if (!tail && c->burst_every > 0U && chance(&rng_bus, 1.0 / (double)c->burst_every)) {
             for (unsigned e = 0U; e < c->burst_frames; ++e) {
-                const odo_can_frame_t ef = {.id = e + 1U == c->burst_frames ? 0x40U : 0x04U, .dlc = 8U,
-                                            .flags = ODO_CAN_FLAG_ERR};
+                const odo_can_frame_t ef = {
+                    .id = e + 1U == c->burst_frames ? 0x40U : 0x04U, .dlc = 8U, .flags = ODO_CAN_FLAG_ERR};
                 replay_push(bad_rp, &ef, fr.t_us);
                 r->error_frames++;
                 r->frames_faulty++;

@@ -19,33 +19,33 @@
 #include "odo/odo_status.h"
 
 typedef struct {
-    uint64_t ticks;          ///< ticks driven (24 h at 40 ms: 2,160,000)
+    uint64_t ticks; ///< ticks driven (24 h at 40 ms: 2,160,000)
     uint64_t seed;
-    double   v_max_mm_s;     ///< fastest wheel speed of the random program (<= 3000, the limit)
-    double   straight_mm_s;  ///< != 0: drive straight ahead at this speed instead of the program
-    double   drop;           ///< probability that a sensor frame is lost
-    double   dup;            ///< ... that it is sent twice
-    double   reorder;        ///< ... that it is swapped with the next tick's frame
-    uint64_t burst_every;    ///< mean ticks between error-frame bursts (0: none); a burst also
-                             ///< destroys that tick's sensor frame
-    unsigned burst_frames;   ///< error frames per burst (the last one of the bus-off class)
-    int64_t  clock_step_us;  ///< the sender's clock steps by this at the middle tick (0: none)
+    double v_max_mm_s;     ///< fastest wheel speed of the random program (<= 3000, the limit)
+    double straight_mm_s;  ///< != 0: drive straight ahead at this speed instead of the program
+    double drop;           ///< probability that a sensor frame is lost
+    double dup;            ///< ... that it is sent twice
+    double reorder;        ///< ... that it is swapped with the next tick's frame
+    uint64_t burst_every;  ///< mean ticks between error-frame bursts (0: none); a burst also
+                           ///< destroys that tick's sensor frame
+    unsigned burst_frames; ///< error frames per burst (the last one of the bus-off class)
+    int64_t clock_step_us; ///< the sender's clock steps by this at the middle tick (0: none)
 } soak_config_t;
 
 typedef struct {
-    uint64_t ticks_clean, ticks_faulty;   ///< steps each replay ran
-    uint64_t frames_sent, frames_faulty;  ///< sensor frames of the drive, frames on the faulty bus
+    uint64_t ticks_clean, ticks_faulty;  ///< steps each replay ran
+    uint64_t frames_sent, frames_faulty; ///< sensor frames of the drive, frames on the faulty bus
     uint64_t dropped, duplicated, reordered, bursts, error_frames;
-    uint64_t clock_steps, gaps;           ///< re-anchorings the faulty replay did
-    uint64_t fault_ticks[ODO_FAULT_COUNT];///< faulty run: ticks that raised each ODO_FAULT_* bit
-    double   path_m;                      ///< clean run: path length of the centre (sum |U|)
-    double   end_pos_err_mm;              ///< faulty vs clean pose at the last tick
-    double   end_heading_err_deg;
-    double   max_pos_err_mm;              ///< worst over the ticks the faulty run integrated a
-                                          ///< sample (its pose caught up): accumulated error
-    double   max_lag_mm;                  ///< worst over every tick (a held pose lags)
-    double   end_x_clean_mm, end_x_faulty_mm; ///< straight drives: travel along x
-    double   wall_s;                      ///< wall-clock time of both replays and the drive
+    uint64_t clock_steps, gaps;            ///< re-anchorings the faulty replay did
+    uint64_t fault_ticks[ODO_FAULT_COUNT]; ///< faulty run: ticks that raised each ODO_FAULT_* bit
+    double path_m;                         ///< clean run: path length of the centre (sum |U|)
+    double end_pos_err_mm;                 ///< faulty vs clean pose at the last tick
+    double end_heading_err_deg;
+    double max_pos_err_mm;                  ///< worst over the ticks the faulty run integrated a
+                                            ///< sample (its pose caught up): accumulated error
+    double max_lag_mm;                      ///< worst over every tick (a held pose lags)
+    double end_x_clean_mm, end_x_faulty_mm; ///< straight drives: travel along x
+    double wall_s;                          ///< wall-clock time of both replays and the drive
 } soak_result_t;
 
 /// The soak: 2,160,000 ticks (24 h), program up to 3 m/s, 20 % lost, 5 % duplicated, 2 %

@@ -30,6 +30,9 @@ extern "C" {
 #define ODO_APP_MAX_FRAMES 6U
 
 /// Flags byte of the POSE_THETA frames: what happened to that truck's pose this tick.
+// A table whose multi-line trailing comments clang-format 14 would turn into backslash
+// continuations (tests/python/test_can_dbc.py reads it): kept as written.
+// clang-format off
 #define ODO_POSE_FLAG_MISSING    0x01U ///< no wheel sample: pose held
 #define ODO_POSE_FLAG_JUMP       0x02U ///< implausible or ambiguous counter reading: pose held,
                                        ///< baseline re-taken
@@ -37,39 +40,40 @@ extern "C" {
 #define ODO_POSE_FLAG_IPEC_GATED 0x08U ///< IPEC is on but was skipped this tick (see faults)
 #define ODO_POSE_FLAG_RANGE      0x10U ///< position beyond ODO_POSE_LIMIT_MM_Q32: pose held
 #define ODO_POSE_FLAG_XY_SATURATED 0x20U ///< POSE_XY carries a saturated x or y (beyond 21.47 km)
+// clang-format on
 
 /// Application state. Plain data, caller-allocated (static on the target); no pointers inside,
 /// so it can be copied to checkpoint a run.
 typedef struct {
-    odo_params_t         params;
-    odo_params_status_t  params_status;  ///< result of the boot-time load (OK or why defaulted)
-    odo_model_t          model[ODO_TRUCKS];
-    odo_truck_t          truck[ODO_TRUCKS];
-    odo_ipec_t           ipec;           ///< linkage bookkeeping (two-truck vehicles)
-    uint8_t              trucks;         ///< 1 (single) or 2 (clapper, set)
-    uint8_t              out_seq;        ///< sequence number of the output frames
-    bool                 seen_seq[ODO_TRUCKS];
-    uint8_t              last_seq[ODO_TRUCKS];
-    uint64_t             last_wheel_t_us[ODO_TRUCKS]; ///< t_us of the truck's last wheel sample
-    bool                 have_time;
-    uint64_t             last_t_us;
-    uint32_t             ticks;          ///< steps run since init (wraps after 2^32)
-    uint32_t             tx_dropped;     ///< output frames the HAL could not queue (odo_loop)
-    odo_fault_counters_t faults;         ///< occurrences per fault bit, saturating
+    odo_params_t params;
+    odo_params_status_t params_status; ///< result of the boot-time load (OK or why defaulted)
+    odo_model_t model[ODO_TRUCKS];
+    odo_truck_t truck[ODO_TRUCKS];
+    odo_ipec_t ipec; ///< linkage bookkeeping (two-truck vehicles)
+    uint8_t trucks;  ///< 1 (single) or 2 (clapper, set)
+    uint8_t out_seq; ///< sequence number of the output frames
+    bool seen_seq[ODO_TRUCKS];
+    uint8_t last_seq[ODO_TRUCKS];
+    uint64_t last_wheel_t_us[ODO_TRUCKS]; ///< t_us of the truck's last wheel sample
+    bool have_time;
+    uint64_t last_t_us;
+    uint32_t ticks;              ///< steps run since init (wraps after 2^32)
+    uint32_t tx_dropped;         ///< output frames the HAL could not queue (odo_loop)
+    odo_fault_counters_t faults; ///< occurrences per fault bit, saturating
 } odo_app_t;
 
 /// What one step produced.
 typedef struct {
-    odo_pose_t      pose[ODO_TRUCKS];
-    int32_t         ipec_dtheta_bam[ODO_TRUCKS]; ///< correction applied this tick (0 when off/gated)
-    int32_t         ipec_innov_bam[ODO_TRUCKS];  ///< measured minus expected link angle (002 Eq. 12)
-                                                 ///< before the estimator; 0 when off/gated
-    bool            ipec_applied;                ///< the IPEC computation ran this tick
-    int64_t         dist_mm_q40[ODO_TRUCKS];     ///< dead-reckoning displacement U_i (0: none)
-    int64_t         dturn_q64[ODO_TRUCKS];       ///< dead-reckoning heading change, signed turns Q64
-    uint32_t        faults;                      ///< ODO_FAULT_* bits raised this tick
-    uint8_t         n_frames;
-    odo_can_frame_t frames[ODO_APP_MAX_FRAMES];  ///< to publish, in order
+    odo_pose_t pose[ODO_TRUCKS];
+    int32_t ipec_dtheta_bam[ODO_TRUCKS]; ///< correction applied this tick (0 when off/gated)
+    int32_t ipec_innov_bam[ODO_TRUCKS];  ///< measured minus expected link angle (002 Eq. 12)
+                                         ///< before the estimator; 0 when off/gated
+    bool ipec_applied;                   ///< the IPEC computation ran this tick
+    int64_t dist_mm_q40[ODO_TRUCKS];     ///< dead-reckoning displacement U_i (0: none)
+    int64_t dturn_q64[ODO_TRUCKS];       ///< dead-reckoning heading change, signed turns Q64
+    uint32_t faults;                     ///< ODO_FAULT_* bits raised this tick
+    uint8_t n_frames;
+    odo_can_frame_t frames[ODO_APP_MAX_FRAMES]; ///< to publish, in order
 } odo_tick_output_t;
 
 /// Boot: load the parameter block (odo_params_load: defaults on any failure), precompute the

@@ -38,10 +38,10 @@ extern "C" {
 /// Result of an unpacker. Map to faults as: ERR_FLAGS with ODO_CAN_FLAG_ERR -> ODO_FAULT_BUS_ERROR,
 /// ERR_ID -> ODO_FAULT_CAN_UNKNOWN_ID, ERR_DLC -> ODO_FAULT_CAN_BAD_DLC.
 typedef enum {
-    ODO_CAN_OK = 0,    ///< decoded; outputs written
-    ODO_CAN_ERR_ID,    ///< identifier is not this message's
-    ODO_CAN_ERR_DLC,   ///< right identifier, wrong length: a sender on another protocol version
-    ODO_CAN_ERR_FLAGS  ///< RTR, error or extended-identifier frame: not one of our data frames
+    ODO_CAN_OK = 0,   ///< decoded; outputs written
+    ODO_CAN_ERR_ID,   ///< identifier is not this message's
+    ODO_CAN_ERR_DLC,  ///< right identifier, wrong length: a sender on another protocol version
+    ODO_CAN_ERR_FLAGS ///< RTR, error or extended-identifier frame: not one of our data frames
 } odo_can_result_t;
 
 /// The frame flags that make a frame not one of this protocol's data frames.
@@ -63,18 +63,18 @@ extern "C" {
 /// Layout of one signal as the DBC's SG_ line has it. All signals are little-endian integers with
 /// start_bit + bit_len <= 8 * dlc of their message.
 typedef struct {
-    const char *name;      ///< DBC signal name, e.g. "LeftCount"
-    uint8_t     start_bit; ///< DBC start bit: position of the least significant bit, 0..63
-    uint8_t     bit_len;   ///< 1..32
-    bool        is_signed; ///< two's complement
+    const char *name;  ///< DBC signal name, e.g. "LeftCount"
+    uint8_t start_bit; ///< DBC start bit: position of the least significant bit, 0..63
+    uint8_t bit_len;   ///< 1..32
+    bool is_signed;    ///< two's complement
 } odo_can_signal_info_t;
 
 /// Layout of one message, for tools and tests (the codec itself uses the generated constants).
 typedef struct {
-    const char                  *name;      ///< DBC message name, e.g. "POSE_XY_A"
-    uint32_t                     id;        ///< 11-bit identifier
-    uint8_t                      dlc;       ///< exact data length
-    uint8_t                      n_signals; ///< entries in signals[], in DBC order
+    const char *name;  ///< DBC message name, e.g. "POSE_XY_A"
+    uint32_t id;       ///< 11-bit identifier
+    uint8_t dlc;       ///< exact data length
+    uint8_t n_signals; ///< entries in signals[], in DBC order
     const odo_can_signal_info_t *signals;
 } odo_can_msg_info_t;
 
@@ -104,10 +104,7 @@ odo_can_result_t odo_can_unpack_signals(odo_can_msg_t m, const odo_can_frame_t *
 
 /// Frames between two sequence numbers, modulo 256: (uint8_t)(seq - prev_seq). 1 is the next
 /// sample, 0 a duplicate (or exactly 256 lost), n > 1 means n - 1 samples were lost.
-static inline uint8_t odo_can_seq_delta(uint8_t prev_seq, uint8_t seq)
-{
-    return (uint8_t)(seq - prev_seq);
-}
+static inline uint8_t odo_can_seq_delta(uint8_t prev_seq, uint8_t seq) { return (uint8_t)(seq - prev_seq); }
 
 #ifdef __cplusplus
 }

@@ -70,7 +70,7 @@ int64_t odo_shr_round_s64(int64_t v, unsigned shift);
 /// series on the remainder (Cortex-M4: about 50 instructions, one or both).
 int32_t odo_sin_q30(uint32_t angle_bam);
 int32_t odo_cos_q30(uint32_t angle_bam);
-void    odo_sincos_q30(uint32_t angle_bam, int32_t *sin_q30, int32_t *cos_q30);
+void odo_sincos_q30(uint32_t angle_bam, int32_t *sin_q30, int32_t *cos_q30);
 
 /// Angle of the vector (x, y) as a BAM in [0, 2^32): atan2(y, x) mapped so that +x is 0 and +y is
 /// ODO_BAM_QUARTER. Any int64 inputs are valid, INT64_MIN included; (0, 0) returns 0. Constant time
@@ -85,30 +85,18 @@ uint32_t odo_atan2_bam(int64_t y, int64_t x);
 
 /// The int32 whose two's-complement bits are u (u mod 2^32 read as signed), without the
 /// implementation-defined conversion of a value above INT32_MAX. A plain move when inlined.
-static inline int32_t odo_as_s32(uint32_t u)
-{
-    return u <= (uint32_t)INT32_MAX ? (int32_t)u : -(int32_t)(~u) - 1;
-}
+static inline int32_t odo_as_s32(uint32_t u) { return u <= (uint32_t)INT32_MAX ? (int32_t)u : -(int32_t)(~u) - 1; }
 
 /// The int64 whose two's-complement bits are u, as odo_as_s32.
-static inline int64_t odo_as_s64(uint64_t u)
-{
-    return u <= (uint64_t)INT64_MAX ? (int64_t)u : -(int64_t)(~u) - 1;
-}
+static inline int64_t odo_as_s64(uint64_t u) { return u <= (uint64_t)INT64_MAX ? (int64_t)u : -(int64_t)(~u) - 1; }
 
 /// floor(v / 2^s) for s in [0, 63]: an arithmetic right shift written without shifting a negative
 /// value (implementation-defined in C99): a negative v is ~(~v >> s), with ~v >= 0. Every int64
 /// is valid. Compilers fold it into the plain arithmetic shift (three Cortex-M4 instructions).
-static inline int64_t odo_floor_shr_s64(int64_t v, unsigned s)
-{
-    return v < 0 ? ~(~v >> s) : v >> s;
-}
+static inline int64_t odo_floor_shr_s64(int64_t v, unsigned s) { return v < 0 ? ~(~v >> s) : v >> s; }
 
 /// floor(v / 2^s) for s in [0, 31], as odo_floor_shr_s64 for int32 (one ASR).
-static inline int32_t odo_floor_shr_s32(int32_t v, unsigned s)
-{
-    return v < 0 ? ~(~v >> s) : v >> s;
-}
+static inline int32_t odo_floor_shr_s32(int32_t v, unsigned s) { return v < 0 ? ~(~v >> s) : v >> s; }
 
 /// floor(a * b / 2^s + 1/2) (round half up), exact through the 96-bit product, for s in [1, 63],
 /// |a| < 2^63 - 2^31 and every b; for s < 32 the caller also keeps |a * b| below 2^(61 + s) so
@@ -134,10 +122,7 @@ static inline int64_t odo_mul_s64_s32_rnd(int64_t a, int32_t b, unsigned s)
 }
 
 /// floor(a * b / 2^32) for unsigned a, b: the high word of one UMULL.
-static inline uint32_t odo_mulhi_u32(uint32_t a, uint32_t b)
-{
-    return (uint32_t)(((uint64_t)a * b) >> 32);
-}
+static inline uint32_t odo_mulhi_u32(uint32_t a, uint32_t b) { return (uint32_t)(((uint64_t)a * b) >> 32); }
 
 /// round(a * b / 2^32), half up: one UMULL (or UMLAL) and the carry.
 static inline uint32_t odo_mulhi_round_u32(uint32_t a, uint32_t b)
@@ -179,7 +164,7 @@ static inline void odo_sincos_q30_inline(uint32_t angle_bam, int32_t *sin_q30, i
     /* d in rad Q32: (r mod 2^24) * 2 pi = (r mod 2^24) * round(pi 2^30) / 2^29 */
     const uint32_t i = r >> 24;
     const uint32_t d = (uint32_t)(((uint64_t)(r & 0xFFFFFFU) * 3373259426U + ((uint64_t)1U << 28)) >> 29);
-    const uint32_t d2 = odo_mulhi_round_u32(d, d);                                 /* d^2 < 6.1e-4 */
+    const uint32_t d2 = odo_mulhi_round_u32(d, d);                                   /* d^2 < 6.1e-4 */
     const uint32_t u = (d2 >> 1) - odo_mulhi_u32(odo_mulhi_u32(d2, d2), 178956971U); /* 1 - cos d */
     const uint32_t sd = d - odo_mulhi_u32(d, odo_mulhi_u32(d2, 715827883U));         /* sin d */
     const uint32_t si = odo_sin_table_q31[i], ci = odo_sin_table_q31[64U - i];

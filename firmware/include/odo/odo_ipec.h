@@ -67,21 +67,21 @@ typedef struct {
 
 /// Per-instance state: the last accepted link reading (jump and sequence checks) and its age.
 typedef struct {
-    bool     have_last;        ///< a reading has been accepted since init
-    uint8_t  last_rot_seq;
-    uint8_t  last_lin_seq;
+    bool have_last; ///< a reading has been accepted since init
+    uint8_t last_rot_seq;
+    uint8_t last_lin_seq;
     uint16_t last_alpha_bam16;
     uint16_t last_beta_bam16;
     uint32_t last_length_um;
-    uint32_t age_ticks;        ///< ticks since the last accepted reading (saturating)
+    uint32_t age_ticks; ///< ticks since the last accepted reading (saturating)
 } odo_ipec_t;
 
 /// What one correction did.
 typedef struct {
-    int32_t  dtheta_bam[2];   ///< heading correction applied to A and B this tick (002 Eq. 12)
-    int32_t  innov_bam[2];    ///< alpha_act - alpha_exp, beta_act - beta_exp before any filtering
-    uint32_t theta_l_bam;     ///< link orientation from B to A (Eq. 10), before re-anchoring
-    int64_t  shift_mm_q32[2]; ///< translational correction of A (Eq. 15 generalised), x and y
+    int32_t dtheta_bam[2];   ///< heading correction applied to A and B this tick (002 Eq. 12)
+    int32_t innov_bam[2];    ///< alpha_act - alpha_exp, beta_act - beta_exp before any filtering
+    uint32_t theta_l_bam;    ///< link orientation from B to A (Eq. 10), before re-anchoring
+    int64_t shift_mm_q32[2]; ///< translational correction of A (Eq. 15 generalised), x and y
 } odo_ipec_result_t;
 
 /// Reset the link bookkeeping (the next reading is accepted without a jump check).
@@ -102,8 +102,7 @@ void odo_ipec_init(odo_ipec_t *s);
 ///                           max_length_jump_um, per tick since the reference (not accepted as
 ///                           the reference either, so a single glitch does not poison the next)
 /// Call once per tick whether or not IPEC is on (the ages count ticks). Constant time.
-uint32_t odo_ipec_check(odo_ipec_t *s, const odo_params_t *p, const odo_link_input_t *in,
-                        odo_ipec_reading_t *rd);
+uint32_t odo_ipec_check(odo_ipec_t *s, const odo_params_t *p, const odo_link_input_t *in, odo_ipec_reading_t *rd);
 
 /// Eq. 10 with the B-to-A convention: direction of (x_A - x_B, y_A - y_B) as a BAM.
 uint32_t odo_ipec_link_heading_bam(const odo_pose_t *a, const odo_pose_t *b);
@@ -115,8 +114,8 @@ void odo_ipec_hitch(const odo_pose_t *a, uint32_t hitch_offset_nm, odo_pose_t *h
 /// travel (sign of dist_mm_q40) along heading + dtheta/2, where heading is p's heading *before*
 /// the correction. dist 0 or dtheta 0: no change. Writes the shift to dx/dy (may be NULL).
 /// wheelbase_nm is the effective wheelbase b. Constant time.
-void odo_ipec_translate(odo_pose_t *p, int32_t dtheta_bam, int64_t dist_mm_q40,
-                        uint32_t wheelbase_nm, int64_t *dx_mm_q32, int64_t *dy_mm_q32);
+void odo_ipec_translate(odo_pose_t *p, int32_t dtheta_bam, int64_t dist_mm_q40, uint32_t wheelbase_nm,
+                        int64_t *dx_mm_q32, int64_t *dy_mm_q32);
 
 /// Eq. 16: place *b (position only) at distance l from *a against theta_L.
 void odo_ipec_anchor(const odo_pose_t *a, uint32_t theta_l_bam, int64_t length_mm_q32, odo_pose_t *b);
@@ -131,8 +130,8 @@ int32_t odo_ipec_gain(uint8_t ipec_mode, int32_t innov_bam, uint8_t rotary_bits)
 /// centre displacement this tick (for the translational correction's direction). Corrects both
 /// headings, A's position (Eq. 15, only the part of the correction beyond half a rotary step, so
 /// quantisation dither does not walk the position), and re-anchors B (Eq. 16). Constant time.
-void odo_ipec_step(const odo_params_t *p, const odo_ipec_reading_t *rd, odo_pose_t pose[2],
-                   int64_t dist_mm_q40, odo_ipec_result_t *out);
+void odo_ipec_step(const odo_params_t *p, const odo_ipec_reading_t *rd, odo_pose_t pose[2], int64_t dist_mm_q40,
+                   odo_ipec_result_t *out);
 
 /// nm -> mm Q32 (exact to 2e-10 relative; saturates beyond +-2.1e15 nm, where mm Q32 leaves int64).
 int64_t odo_ipec_nm_to_mm_q32(int64_t nm);

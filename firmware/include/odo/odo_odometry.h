@@ -44,39 +44,39 @@ extern "C" {
 
 /// Per-truck multipliers, precomputed by odo_model_init from one odo_truck_params_t.
 typedef struct {
-    int64_t  dist_mm_q40[2];  ///< distance per count, [ODO_LEFT, ODO_RIGHT]: cL/R * cm (Eq. 6.35)
-    uint64_t turn_q64[2];     ///< heading change per count: dist / (2 pi b_eff) (Eq. 2.4), turns Q64
+    int64_t dist_mm_q40[2];     ///< distance per count, [ODO_LEFT, ODO_RIGHT]: cL/R * cm (Eq. 6.35)
+    uint64_t turn_q64[2];       ///< heading change per count: dist / (2 pi b_eff) (Eq. 2.4), turns Q64
     uint64_t scrub_turn_q64[2]; ///< k * turn_q64[w], two's complement (the scrub term's k dtheta)
-    int32_t  scrub_q30;       ///< k of the scrub term (odo_truck_params_t); 0: term skipped
-    uint32_t max_counts;      ///< largest believable |delta| per tick (from max_wheel_speed_mm_s)
-    uint32_t max_delta_counts;///< largest |delta| one step can integrate (k |delta| < 2^61 mm Q40
-                              ///< on both wheels; >= max_counts), for steps over a gap
-    uint8_t  counter_bits;    ///< decoder counter width, ODO_COUNTER_BITS_MIN..ODO_COUNTER_BITS_MAX
-    uint8_t  invert;          ///< ODO_TRUCK_INVERT_* flags
-    uint8_t  heading_form;    ///< odo_heading_form_t
+    int32_t scrub_q30;          ///< k of the scrub term (odo_truck_params_t); 0: term skipped
+    uint32_t max_counts;        ///< largest believable |delta| per tick (from max_wheel_speed_mm_s)
+    uint32_t max_delta_counts;  ///< largest |delta| one step can integrate (k |delta| < 2^61 mm Q40
+                                ///< on both wheels; >= max_counts), for steps over a gap
+    uint8_t counter_bits;       ///< decoder counter width, ODO_COUNTER_BITS_MIN..ODO_COUNTER_BITS_MAX
+    uint8_t invert;             ///< ODO_TRUCK_INVERT_* flags
+    uint8_t heading_form;       ///< odo_heading_form_t
 } odo_model_t;
 
 /// A truck's dead-reckoning state.
 typedef struct {
     odo_pose_t pose;
-    uint32_t   last_raw[2]; ///< last accepted raw counter values
-    bool       primed;      ///< last_raw holds a reading (the first reading only sets the baseline)
+    uint32_t last_raw[2]; ///< last accepted raw counter values
+    bool primed;          ///< last_raw holds a reading (the first reading only sets the baseline)
 } odo_truck_t;
 
 /// What one odometry step did.
 typedef struct {
-    int64_t  dist_mm_q40;  ///< centre-point displacement U_i (000 Eq. 2.3), mm Q40
-    int64_t  dturn_q64;    ///< heading change dtheta_i (000 Eq. 2.4), signed turns Q64
-    int32_t  delta[2];     ///< accepted count deltas, forward positive
-    bool     jump;         ///< implausible or ambiguous reading (see odo_truck_step): nothing
-                           ///< integrated, baseline re-taken
-    bool     range;        ///< the pose is beyond ODO_POSE_LIMIT_MM_Q32 (odo_pose_in_range false);
-                           ///< if it already was, nothing was integrated (pose held)
+    int64_t dist_mm_q40; ///< centre-point displacement U_i (000 Eq. 2.3), mm Q40
+    int64_t dturn_q64;   ///< heading change dtheta_i (000 Eq. 2.4), signed turns Q64
+    int32_t delta[2];    ///< accepted count deltas, forward positive
+    bool jump;           ///< implausible or ambiguous reading (see odo_truck_step): nothing
+                         ///< integrated, baseline re-taken
+    bool range;          ///< the pose is beyond ODO_POSE_LIMIT_MM_Q32 (odo_pose_in_range false);
+                         ///< if it already was, nothing was integrated (pose held)
 } odo_step_t;
 
 typedef enum {
     ODO_MODEL_OK = 0,
-    ODO_MODEL_ERR_RANGE,    ///< the parameters give multipliers that do not fit the number formats
+    ODO_MODEL_ERR_RANGE, ///< the parameters give multipliers that do not fit the number formats
 } odo_model_status_t;
 
 /// Counter widths a wheel decoder may have (odo_params_t.counter_bits; real decoders: 8 to 32).
@@ -95,8 +95,7 @@ typedef enum {
 /// Q40, or max_counts reaches half the counter range (the modular delta would be ambiguous: an
 /// 8-bit counter allows at most 127 counts per tick); params must already pass odo_params_validate.
 odo_model_status_t odo_model_init(odo_model_t *m, const odo_truck_params_t *tp, uint8_t counter_bits,
-                                  uint8_t heading_form, uint32_t tick_us,
-                                  uint32_t max_wheel_speed_mm_s);
+                                  uint8_t heading_form, uint32_t tick_us, uint32_t max_wheel_speed_mm_s);
 
 /// Signed difference cur - prev of two raw counter readings modulo 2^bits, interpreted in
 /// [-2^(bits-1), 2^(bits-1)). Handles every wrap of any counter width. bits above 32 count as
@@ -136,8 +135,8 @@ void odo_truck_reset(odo_truck_t *t, const odo_pose_t *pose);
 /// turn in one step (a spin at speed over a long gap) is kept exactly modulo a turn (the scrub
 /// term, from two turns on), but its midpoint direction is then taken the short way round.
 /// Never fails otherwise. Constant time: no loop over the gap.
-void odo_truck_step(odo_truck_t *t, const odo_model_t *m, uint32_t left_raw, uint32_t right_raw,
-                    uint8_t bits, uint32_t ticks, odo_step_t *out);
+void odo_truck_step(odo_truck_t *t, const odo_model_t *m, uint32_t left_raw, uint32_t right_raw, uint8_t bits,
+                    uint32_t ticks, odo_step_t *out);
 
 /// The tyre-scrub part of one tick's heading change, k dtheta m / v in signed turns Q64 (the term
 /// above; odo_truck_step subtracts it when k != 0), for accepted deltas (|d| <= max_delta_counts).
@@ -170,7 +169,7 @@ uint32_t odo_truck_tick(odo_truck_t *t, const odo_model_t *m, const odo_wheel_in
 /// up, saturating to int32: +-21.47 km, the POSE_XY frame's range; *saturated, if not NULL, is set
 /// true when it saturated and left alone otherwise).
 uint32_t odo_heading_bam(const odo_pose_t *p);
-int32_t  odo_mm_q32_to_10um(int64_t v_mm_q32, bool *saturated);
+int32_t odo_mm_q32_to_10um(int64_t v_mm_q32, bool *saturated);
 
 /// mm Q32 to units of 10 um, rounded half up, not saturated: floor(v * 100 / 2^32 + 1/2), exact
 /// for every int64 (the result is below 2^38 in magnitude). With v = hi 2^32 + lo: hi * 100 plus

@@ -64,28 +64,28 @@ extern "C" {
 #define ODO_PARAMS_VERSION       2U           ///< the version odo_params_encode writes
 #define ODO_PARAMS_SIZE          256U         ///< bytes of a version-2 block, CRC included
 #define ODO_PARAMS_CRC_OFFSET    252U
-#define ODO_PARAMS_V1_SIZE       128U         ///< bytes of a version-1 block (read only)
+#define ODO_PARAMS_V1_SIZE       128U ///< bytes of a version-1 block (read only)
 #define ODO_PARAMS_V1_CRC_OFFSET 124U
-#define ODO_PARAMS_HEADER_SIZE   8U           ///< magic, version, length: what a block claims
+#define ODO_PARAMS_HEADER_SIZE   8U ///< magic, version, length: what a block claims
 
 /// Q30 representation of a dimensionless ratio: 1.0 == 2^30.
 #define ODO_RATIO_Q30_ONE ((int32_t)1 << 30)
 
 typedef enum {
-    ODO_VEHICLE_SINGLE  = 0, ///< one differential-drive truck (labmate)
+    ODO_VEHICLE_SINGLE = 0,  ///< one differential-drive truck (labmate)
     ODO_VEHICLE_CLAPPER = 1, ///< two trucks on a compliant linkage (004 section 2)
-    ODO_VEHICLE_SET     = 2  ///< one truck towing a passive encoder trailer (000 section 4.6)
+    ODO_VEHICLE_SET = 2      ///< one truck towing a passive encoder trailer (000 section 4.6)
 } odo_vehicle_t;
 
 typedef enum {
     ODO_HEADING_MIDPOINT = 0, ///< position advanced along theta_{i-1} + dtheta/2 (default)
-    ODO_HEADING_PAPER    = 1  ///< position advanced along the new theta_i (000 Eq. 2.6)
+    ODO_HEADING_PAPER = 1     ///< position advanced along the new theta_i (000 Eq. 2.6)
 } odo_heading_form_t;
 
 typedef enum {
-    ODO_IPEC_OFF       = 0,
-    ODO_IPEC_PAPER     = 1, ///< the per-tick correction of 002 Eqs. 9-16
-    ODO_IPEC_ESTIMATOR = 2  ///< per-tick correction plus the sub-resolution estimator
+    ODO_IPEC_OFF = 0,
+    ODO_IPEC_PAPER = 1,    ///< the per-tick correction of 002 Eqs. 9-16
+    ODO_IPEC_ESTIMATOR = 2 ///< per-tick correction plus the sub-resolution estimator
 } odo_ipec_mode_t;
 
 #define ODO_TRUCK_INVERT_LEFT  0x01U ///< left counter counts down when the wheel rolls forward
@@ -98,14 +98,14 @@ typedef struct {
     uint32_t counts_per_rev_milli; ///< decoded counts per wheel turn (n * Ce, after 4x) x 1000;
                                    ///< [100 counts, 4e6 counts]
     uint32_t wheelbase_nm;         ///< nominal wheelbase b (000 Eq. 2.4); [50 mm, 3 m]
-    int32_t  ed_q30;               ///< Ed = DR/DL (000 Eq. 2.7, found by Eq. 6.24); [0.8, 1.25]
-    int32_t  eb_q30;               ///< Eb = b_actual/b_nominal on spot turns (000 Eq. 2.8, 6.28);
+    int32_t ed_q30;                ///< Ed = DR/DL (000 Eq. 2.7, found by Eq. 6.24); [0.8, 1.25]
+    int32_t eb_q30;                ///< Eb = b_actual/b_nominal on spot turns (000 Eq. 2.8, 6.28);
                                    ///< [0.8, 1.25]
-    int32_t  es_q30;               ///< Es = L_calc/L_actual (000 Eq. B.1); [0.8, 1.25]
-    int32_t  scrub_q30;            ///< k of the tyre-scrub term (effect `scrub`, odo_odometry.h):
+    int32_t es_q30;                ///< Es = L_calc/L_actual (000 Eq. B.1); [0.8, 1.25]
+    int32_t scrub_q30;             ///< k of the tyre-scrub term (effect `scrub`, odo_odometry.h):
                                    ///< on an arc of spin fraction s the effective wheelbase is
                                    ///< b Eb / (1 - k (1 - s)); [-0.25, 0.25], 0 = off (version 1)
-    uint8_t  flags;                ///< ODO_TRUCK_INVERT_*; other bits must be 0
+    uint8_t flags;                 ///< ODO_TRUCK_INVERT_*; other bits must be 0
 } odo_truck_params_t;
 
 /// Linkage (clapper) or trailer joint (set) geometry and IPEC gating limits.
@@ -113,11 +113,11 @@ typedef struct {
     uint32_t length_nm;          ///< nominal link length l (clapper, 004 s. 2: 1 m) or the joint to
                                  ///< trailer-axle distance (set); [100 mm, 4 m]
     uint32_t hitch_offset_nm;    ///< set: robot centre to joint, behind the robot; [0, 4 m]
-    int32_t  length_bias_nm;     ///< linear-encoder bias, subtracted (002 s. 5.2); |.| <= 50 mm
-    int32_t  length_ecc_nm;      ///< eccentric part of the bias (see ipec); |.| <= 50 mm
-    int32_t  alpha_bias_bam;     ///< rotary encoder A zero offset, subtracted; |.| <= 10 deg
-    int32_t  beta_bias_bam;      ///< rotary encoder B zero offset, subtracted; |.| <= 10 deg
-    uint8_t  rotary_bits;        ///< absolute rotary encoder resolution (004: 10); [8, 16]
+    int32_t length_bias_nm;      ///< linear-encoder bias, subtracted (002 s. 5.2); |.| <= 50 mm
+    int32_t length_ecc_nm;       ///< eccentric part of the bias (see ipec); |.| <= 50 mm
+    int32_t alpha_bias_bam;      ///< rotary encoder A zero offset, subtracted; |.| <= 10 deg
+    int32_t beta_bias_bam;       ///< rotary encoder B zero offset, subtracted; |.| <= 10 deg
+    uint8_t rotary_bits;         ///< absolute rotary encoder resolution (004: 10); [8, 16]
     uint16_t stale_ticks;        ///< linkage data older than this gates IPEC off; [1, 1000]
     uint32_t max_jump_bam;       ///< largest believable per-tick change of alpha/beta; [1, 90 deg]
     uint32_t max_length_jump_um; ///< largest believable per-tick change of l; [1 um, 1 m]
@@ -126,14 +126,14 @@ typedef struct {
 } odo_link_params_t;
 
 typedef struct {
-    uint8_t  vehicle;              ///< odo_vehicle_t
-    uint8_t  counter_bits;         ///< wheel decoder counter width, any of 8..32 bits
-    uint8_t  heading_form;         ///< odo_heading_form_t
-    uint8_t  ipec_mode;            ///< odo_ipec_mode_t
+    uint8_t vehicle;               ///< odo_vehicle_t
+    uint8_t counter_bits;          ///< wheel decoder counter width, any of 8..32 bits
+    uint8_t heading_form;          ///< odo_heading_form_t
+    uint8_t ipec_mode;             ///< odo_ipec_mode_t
     uint32_t tick_us;              ///< application step period; [1 ms, 1 s]; 40 ms (002 s. 4.1)
     uint32_t max_wheel_speed_mm_s; ///< faster wheel motion is a counter fault; [100, 20000]
     odo_truck_params_t truck[ODO_TRUCKS];
-    odo_link_params_t  link;
+    odo_link_params_t link;
 } odo_params_t;
 
 /* ---------------------------------------------------------------------------------------------
@@ -141,14 +141,14 @@ typedef struct {
  * ------------------------------------------------------------------------------------------- */
 
 /// Units of the limits below (nm, um, BAM: 2^32 per turn, rounded to nearest).
-#define ODO_NM_PER_MM      INT64_C(1000000)
-#define ODO_UM_PER_MM      INT64_C(1000)
-#define ODO_DEG_TO_BAM(d)  (((((int64_t)(d)) << 32) + 180) / 360)
+#define ODO_NM_PER_MM     INT64_C(1000000)
+#define ODO_UM_PER_MM     INT64_C(1000)
+#define ODO_DEG_TO_BAM(d) (((((int64_t)(d)) << 32) + 180) / 360)
 /// Q30 ratio limits: 0.8 is not representable (0.8 * 2^30 = 858993459.2, truncated); 1.25 is.
-#define ODO_RATIO_MIN_Q30  ((((int64_t)4) << 30) / 5)
-#define ODO_RATIO_MAX_Q30  ((((int64_t)5) << 30) / 4)
+#define ODO_RATIO_MIN_Q30 ((((int64_t)4) << 30) / 5)
+#define ODO_RATIO_MAX_Q30 ((((int64_t)5) << 30) / 4)
 /// |scrub| <= 0.25 in Q30: beyond, the wheelbase factor 1/(1 - k (1 - s)) leaves [0.8, 1.34].
-#define ODO_SCRUB_MAX_Q30  (((int64_t)1) << 28)
+#define ODO_SCRUB_MAX_Q30 (((int64_t)1) << 28)
 
 /// Every field of the block, once, in validation order:
 ///   X(id, scope, member, json, since, offset, stride, type, min, max, unit)
@@ -162,47 +162,42 @@ typedef struct {
 ///   min/max inclusive range odo_params_validate enforces; unit: scale and unit, for people
 /// Checks beyond one field's range: link.length_min_um < link.length_max_um (ODO_PF_LENGTH_RANGE).
 /// flags' range [0, 3] is exactly "no bit but the two ODO_TRUCK_INVERT_* bits".
-#define ODO_PARAMS_FIELDS(X)                                                                         \
-    X(VEHICLE, TOP, vehicle, "vehicle", 1, 8, 0, U8, 0, 2, "odo_vehicle_t")                          \
-    X(COUNTER_BITS, TOP, counter_bits, "counter_bits", 1, 9, 0, U8, 8, 32, "bits")                   \
-    X(HEADING_FORM, TOP, heading_form, "heading_form", 1, 10, 0, U8, 0, 1, "odo_heading_form_t")     \
-    X(IPEC_MODE, TOP, ipec_mode, "ipec_mode", 1, 11, 0, U8, 0, 2, "odo_ipec_mode_t")                 \
-    X(TICK_US, TOP, tick_us, "tick_us", 1, 12, 0, U32, 1000, 1000000, "us")                          \
-    X(MAX_WHEEL_SPEED, TOP, max_wheel_speed_mm_s, "max_wheel_speed_mm_s", 1, 16, 0, U32, 100, 20000, \
-      "mm/s")                                                                                        \
-    X(WHEEL_DIAMETER, TRUCK, wheel_diameter_nm, "wheel_diameter_nm", 1, 20, 28, U32,                 \
-      10 * ODO_NM_PER_MM, 2000 * ODO_NM_PER_MM, "nm")                                                \
-    X(COUNTS_PER_REV, TRUCK, counts_per_rev_milli, "counts_per_rev_milli", 1, 24, 28, U32,           \
-      INT64_C(100000), INT64_C(4000000000), "counts per wheel turn x 1000")                          \
-    X(WHEELBASE, TRUCK, wheelbase_nm, "wheelbase_nm", 1, 28, 28, U32, 50 * ODO_NM_PER_MM,            \
-      3000 * ODO_NM_PER_MM, "nm")                                                                    \
-    X(ED, TRUCK, ed_q30, "ed_q30", 1, 32, 28, I32, ODO_RATIO_MIN_Q30, ODO_RATIO_MAX_Q30, "Q30")      \
-    X(EB, TRUCK, eb_q30, "eb_q30", 1, 36, 28, I32, ODO_RATIO_MIN_Q30, ODO_RATIO_MAX_Q30, "Q30")      \
-    X(ES, TRUCK, es_q30, "es_q30", 1, 40, 28, I32, ODO_RATIO_MIN_Q30, ODO_RATIO_MAX_Q30, "Q30")      \
-    X(SCRUB, TRUCK, scrub_q30, "scrub_q30", 2, 124, 4, I32, -ODO_SCRUB_MAX_Q30, ODO_SCRUB_MAX_Q30,   \
-      "Q30")                                                                                         \
-    X(TRUCK_FLAGS, TRUCK, flags, "flags", 1, 44, 28, U8, 0, 3, "ODO_TRUCK_INVERT_* bits")            \
-    X(LINK_LENGTH, LINK, link.length_nm, "link.length_nm", 1, 76, 0, U32, 100 * ODO_NM_PER_MM,       \
-      4000 * ODO_NM_PER_MM, "nm")                                                                    \
-    X(HITCH_OFFSET, LINK, link.hitch_offset_nm, "link.hitch_offset_nm", 1, 80, 0, U32, 0,            \
-      4000 * ODO_NM_PER_MM, "nm")                                                                    \
-    X(LENGTH_BIAS, LINK, link.length_bias_nm, "link.length_bias_nm", 1, 84, 0, I32,                  \
-      -50 * ODO_NM_PER_MM, 50 * ODO_NM_PER_MM, "nm")                                                 \
-    X(LENGTH_ECC, LINK, link.length_ecc_nm, "link.length_ecc_nm", 1, 88, 0, I32,                     \
-      -50 * ODO_NM_PER_MM, 50 * ODO_NM_PER_MM, "nm")                                                 \
-    X(ALPHA_BIAS, LINK, link.alpha_bias_bam, "link.alpha_bias_bam", 1, 92, 0, I32,                   \
-      -ODO_DEG_TO_BAM(10), ODO_DEG_TO_BAM(10), "BAM")                                                \
-    X(BETA_BIAS, LINK, link.beta_bias_bam, "link.beta_bias_bam", 1, 96, 0, I32,                      \
-      -ODO_DEG_TO_BAM(10), ODO_DEG_TO_BAM(10), "BAM")                                                \
-    X(ROTARY_BITS, LINK, link.rotary_bits, "link.rotary_bits", 1, 100, 0, U8, 8, 16, "bits")         \
-    X(STALE_TICKS, LINK, link.stale_ticks, "link.stale_ticks", 1, 102, 0, U16, 1, 1000, "ticks")     \
-    X(MAX_JUMP, LINK, link.max_jump_bam, "link.max_jump_bam", 1, 104, 0, U32, 1, ODO_DEG_TO_BAM(90), \
-      "BAM")                                                                                         \
-    X(MAX_LENGTH_JUMP, LINK, link.max_length_jump_um, "link.max_length_jump_um", 1, 108, 0, U32, 1,  \
-      1000 * ODO_UM_PER_MM, "um")                                                                    \
-    X(LENGTH_MIN, LINK, link.length_min_um, "link.length_min_um", 1, 112, 0, U32, ODO_UM_PER_MM,     \
-      20000 * ODO_UM_PER_MM, "um")                                                                   \
-    X(LENGTH_MAX, LINK, link.length_max_um, "link.length_max_um", 1, 116, 0, U32, ODO_UM_PER_MM,     \
+#define ODO_PARAMS_FIELDS(X)                                                                                          \
+    X(VEHICLE, TOP, vehicle, "vehicle", 1, 8, 0, U8, 0, 2, "odo_vehicle_t")                                           \
+    X(COUNTER_BITS, TOP, counter_bits, "counter_bits", 1, 9, 0, U8, 8, 32, "bits")                                    \
+    X(HEADING_FORM, TOP, heading_form, "heading_form", 1, 10, 0, U8, 0, 1, "odo_heading_form_t")                      \
+    X(IPEC_MODE, TOP, ipec_mode, "ipec_mode", 1, 11, 0, U8, 0, 2, "odo_ipec_mode_t")                                  \
+    X(TICK_US, TOP, tick_us, "tick_us", 1, 12, 0, U32, 1000, 1000000, "us")                                           \
+    X(MAX_WHEEL_SPEED, TOP, max_wheel_speed_mm_s, "max_wheel_speed_mm_s", 1, 16, 0, U32, 100, 20000, "mm/s")          \
+    X(WHEEL_DIAMETER, TRUCK, wheel_diameter_nm, "wheel_diameter_nm", 1, 20, 28, U32, 10 * ODO_NM_PER_MM,              \
+      2000 * ODO_NM_PER_MM, "nm")                                                                                     \
+    X(COUNTS_PER_REV, TRUCK, counts_per_rev_milli, "counts_per_rev_milli", 1, 24, 28, U32, INT64_C(100000),           \
+      INT64_C(4000000000), "counts per wheel turn x 1000")                                                            \
+    X(WHEELBASE, TRUCK, wheelbase_nm, "wheelbase_nm", 1, 28, 28, U32, 50 * ODO_NM_PER_MM, 3000 * ODO_NM_PER_MM, "nm") \
+    X(ED, TRUCK, ed_q30, "ed_q30", 1, 32, 28, I32, ODO_RATIO_MIN_Q30, ODO_RATIO_MAX_Q30, "Q30")                       \
+    X(EB, TRUCK, eb_q30, "eb_q30", 1, 36, 28, I32, ODO_RATIO_MIN_Q30, ODO_RATIO_MAX_Q30, "Q30")                       \
+    X(ES, TRUCK, es_q30, "es_q30", 1, 40, 28, I32, ODO_RATIO_MIN_Q30, ODO_RATIO_MAX_Q30, "Q30")                       \
+    X(SCRUB, TRUCK, scrub_q30, "scrub_q30", 2, 124, 4, I32, -ODO_SCRUB_MAX_Q30, ODO_SCRUB_MAX_Q30, "Q30")             \
+    X(TRUCK_FLAGS, TRUCK, flags, "flags", 1, 44, 28, U8, 0, 3, "ODO_TRUCK_INVERT_* bits")                             \
+    X(LINK_LENGTH, LINK, link.length_nm, "link.length_nm", 1, 76, 0, U32, 100 * ODO_NM_PER_MM, 4000 * ODO_NM_PER_MM,  \
+      "nm")                                                                                                           \
+    X(HITCH_OFFSET, LINK, link.hitch_offset_nm, "link.hitch_offset_nm", 1, 80, 0, U32, 0, 4000 * ODO_NM_PER_MM, "nm") \
+    X(LENGTH_BIAS, LINK, link.length_bias_nm, "link.length_bias_nm", 1, 84, 0, I32, -50 * ODO_NM_PER_MM,              \
+      50 * ODO_NM_PER_MM, "nm")                                                                                       \
+    X(LENGTH_ECC, LINK, link.length_ecc_nm, "link.length_ecc_nm", 1, 88, 0, I32, -50 * ODO_NM_PER_MM,                 \
+      50 * ODO_NM_PER_MM, "nm")                                                                                       \
+    X(ALPHA_BIAS, LINK, link.alpha_bias_bam, "link.alpha_bias_bam", 1, 92, 0, I32, -ODO_DEG_TO_BAM(10),               \
+      ODO_DEG_TO_BAM(10), "BAM")                                                                                      \
+    X(BETA_BIAS, LINK, link.beta_bias_bam, "link.beta_bias_bam", 1, 96, 0, I32, -ODO_DEG_TO_BAM(10),                  \
+      ODO_DEG_TO_BAM(10), "BAM")                                                                                      \
+    X(ROTARY_BITS, LINK, link.rotary_bits, "link.rotary_bits", 1, 100, 0, U8, 8, 16, "bits")                          \
+    X(STALE_TICKS, LINK, link.stale_ticks, "link.stale_ticks", 1, 102, 0, U16, 1, 1000, "ticks")                      \
+    X(MAX_JUMP, LINK, link.max_jump_bam, "link.max_jump_bam", 1, 104, 0, U32, 1, ODO_DEG_TO_BAM(90), "BAM")           \
+    X(MAX_LENGTH_JUMP, LINK, link.max_length_jump_um, "link.max_length_jump_um", 1, 108, 0, U32, 1,                   \
+      1000 * ODO_UM_PER_MM, "um")                                                                                     \
+    X(LENGTH_MIN, LINK, link.length_min_um, "link.length_min_um", 1, 112, 0, U32, ODO_UM_PER_MM,                      \
+      20000 * ODO_UM_PER_MM, "um")                                                                                    \
+    X(LENGTH_MAX, LINK, link.length_max_um, "link.length_max_um", 1, 116, 0, U32, ODO_UM_PER_MM,                      \
       20000 * ODO_UM_PER_MM, "um")
 
 /// Field identifiers: one per ODO_PARAMS_FIELDS entry, in table order, then the two that are not
@@ -212,8 +207,8 @@ typedef enum {
 #define ODO_PF_ENUM_(id, ...) ODO_PF_##id,
     ODO_PARAMS_FIELDS(ODO_PF_ENUM_)
 #undef ODO_PF_ENUM_
-    ODO_PF_LENGTH_RANGE, ///< link.length_min_um >= link.length_max_um
-    ODO_PF_RESERVED      ///< a reserved byte is non-zero (odo_params_reserved_offset says which)
+        ODO_PF_LENGTH_RANGE, ///< link.length_min_um >= link.length_max_um
+    ODO_PF_RESERVED          ///< a reserved byte is non-zero (odo_params_reserved_offset says which)
 } odo_param_field_t;
 
 typedef enum { ODO_PSCOPE_TOP = 0, ODO_PSCOPE_TRUCK = 1, ODO_PSCOPE_LINK = 2 } odo_param_scope_t;
@@ -221,17 +216,17 @@ typedef enum { ODO_PTYPE_U8 = 0, ODO_PTYPE_U16 = 1, ODO_PTYPE_U32 = 2, ODO_PTYPE
 
 /// One row of ODO_PARAMS_FIELDS as data, for code that walks the fields (codec, JSON, tools).
 typedef struct {
-    int64_t     min;    ///< inclusive range
-    int64_t     max;
-    const char *name;   ///< `json`: odo_params_field_name of this field
-    uint16_t    offset; ///< byte offset in the block (truck fields: truck A's)
-    uint16_t    stride; ///< truck fields: truck B's offset minus truck A's; otherwise 0
-    uint16_t    member; ///< offsetof the member in odo_truck_params_t (TRUCK) or odo_params_t
-    uint8_t     id;     ///< odo_param_field_t
-    uint8_t     scope;  ///< odo_param_scope_t
-    uint8_t     type;   ///< odo_param_type_t
-    uint8_t     width;  ///< bytes: 1, 2 or 4
-    uint8_t     since;  ///< first layout version carrying the field
+    int64_t min; ///< inclusive range
+    int64_t max;
+    const char *name; ///< `json`: odo_params_field_name of this field
+    uint16_t offset;  ///< byte offset in the block (truck fields: truck A's)
+    uint16_t stride;  ///< truck fields: truck B's offset minus truck A's; otherwise 0
+    uint16_t member;  ///< offsetof the member in odo_truck_params_t (TRUCK) or odo_params_t
+    uint8_t id;       ///< odo_param_field_t
+    uint8_t scope;    ///< odo_param_scope_t
+    uint8_t type;     ///< odo_param_type_t
+    uint8_t width;    ///< bytes: 1, 2 or 4
+    uint8_t since;    ///< first layout version carrying the field
 } odo_param_field_info_t;
 
 /// Number of ODO_PARAMS_FIELDS entries; odo_params_field_at(i) is entry i (id i + 1), or NULL iff
@@ -282,8 +277,7 @@ void odo_params_defaults(odo_params_t *p);
 /// then the length pair). Returns ODO_PARAMS_OK or ODO_PARAMS_ERR_RANGE; on error *bad_field (if
 /// not NULL) names the first offending field and *bad_truck (if not NULL) its truck index.
 /// Linear in the number of fields; no loops otherwise.
-odo_params_status_t odo_params_validate(const odo_params_t *p, odo_param_field_t *bad_field,
-                                        uint8_t *bad_truck);
+odo_params_status_t odo_params_validate(const odo_params_t *p, odo_param_field_t *bad_field, uint8_t *bad_truck);
 
 /// Serialise to exactly ODO_PARAMS_SIZE bytes of layout version ODO_PARAMS_VERSION with header
 /// and CRC. Returns the byte count, or 0 iff cap < ODO_PARAMS_SIZE or an argument is NULL. Does

@@ -46,19 +46,19 @@ extern "C" {
 #endif
 
 /// Least straight travel (um) and least turning (BAM) before Ed / Eb are estimated.
-#define ODO_SELFCAL_MIN_STRAIGHT_UM 2000000LL   /* 2 m */
+#define ODO_SELFCAL_MIN_STRAIGHT_UM 2000000LL    /* 2 m */
 #define ODO_SELFCAL_MIN_TURN_BAM    1073741824LL /* 90 deg */
 
 /// One truck's sums (see the banner).
 typedef struct {
-    int64_t  straight_um;      ///< sum |U| over straight ticks
-    int64_t  straight_corr;    ///< sum sgn(U) C over straight ticks (BAM)
-    int64_t  turn_bam;         ///< sum |T| over turning ticks (BAM)
-    int64_t  turn_corr;        ///< sum sgn(T) C over turning ticks (BAM)
-    int64_t  turn_u_um;        ///< sum sgn(T) U over turning ticks
+    int64_t straight_um;   ///< sum |U| over straight ticks
+    int64_t straight_corr; ///< sum sgn(U) C over straight ticks (BAM)
+    int64_t turn_bam;      ///< sum |T| over turning ticks (BAM)
+    int64_t turn_corr;     ///< sum sgn(T) C over turning ticks (BAM)
+    int64_t turn_u_um;     ///< sum sgn(T) U over turning ticks
     uint32_t straight_ticks;
     uint32_t turn_ticks;
-    uint32_t skipped_ticks;    ///< left out: in between, too large a correction
+    uint32_t skipped_ticks; ///< left out: in between, too large a correction
 } odo_selfcal_truck_t;
 
 typedef struct {
@@ -67,26 +67,25 @@ typedef struct {
 
 /// What an estimate found, per truck.
 typedef struct {
-    bool    have_ed[ODO_TRUCKS];  ///< enough straight travel: ed_q30 updated
-    bool    have_eb[ODO_TRUCKS];  ///< enough turning: eb_q30 updated
-    int32_t k_q30[ODO_TRUCKS];    ///< Ed_f / Ed_t - 1
-    int32_t c_q30[ODO_TRUCKS];    ///< b_f / b_t - 1
-    int32_t corr_per_m_bam[ODO_TRUCKS];   ///< straight: sum sgn(U) C per metre of travel
-    int32_t corr_per_turn_bam[ODO_TRUCKS];///< turning: sum sgn(T) (C - a U) per full turn
+    bool have_ed[ODO_TRUCKS];              ///< enough straight travel: ed_q30 updated
+    bool have_eb[ODO_TRUCKS];              ///< enough turning: eb_q30 updated
+    int32_t k_q30[ODO_TRUCKS];             ///< Ed_f / Ed_t - 1
+    int32_t c_q30[ODO_TRUCKS];             ///< b_f / b_t - 1
+    int32_t corr_per_m_bam[ODO_TRUCKS];    ///< straight: sum sgn(U) C per metre of travel
+    int32_t corr_per_turn_bam[ODO_TRUCKS]; ///< turning: sum sgn(T) (C - a U) per full turn
 } odo_selfcal_result_t;
 
 void odo_selfcal_init(odo_selfcal_t *s);
 
 /// One truck's tick: dist_mm_q40 = U, dturn_q64 = T (odo_tick_output_t), dtheta_bam = C.
 /// wheelbase_nm: the firmware's effective wheelbase (b_n Eb_f); rotary_bits: the link encoders'.
-void odo_selfcal_add(odo_selfcal_t *s, uint8_t truck, uint32_t wheelbase_nm, uint8_t rotary_bits,
-                     int64_t dist_mm_q40, int64_t dturn_q64, int32_t dtheta_bam);
+void odo_selfcal_add(odo_selfcal_t *s, uint8_t truck, uint32_t wheelbase_nm, uint8_t rotary_bits, int64_t dist_mm_q40,
+                     int64_t dturn_q64, int32_t dtheta_bam);
 
 /// Estimate Ed and Eb of every truck that has enough data and write them into *out (a copy of
 /// *in otherwise; in and out may alias). Returns true if at least one value was estimated and
 /// *out passes odo_params_validate; false leaves *out = *in.
-bool odo_selfcal_estimate(const odo_selfcal_t *s, const odo_params_t *in, odo_params_t *out,
-                          odo_selfcal_result_t *r);
+bool odo_selfcal_estimate(const odo_selfcal_t *s, const odo_params_t *in, odo_params_t *out, odo_selfcal_result_t *r);
 
 #ifdef __cplusplus
 }

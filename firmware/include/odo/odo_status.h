@@ -9,6 +9,9 @@
 extern "C" {
 #endif
 
+// A table whose multi-line trailing comments clang-format 14 would turn into backslash
+// continuations (tests/python/test_can_dbc.py reads it): kept as written.
+// clang-format off
 #define ODO_FAULT_PARAMS_DEFAULTED  (1UL << 0)  ///< parameter block rejected at boot; defaults in use
 #define ODO_FAULT_COUNTER_JUMP_A    (1UL << 1)  ///< a wheel count delta above the physical limit for
                                                 ///< the ticks elapsed, or a gap too long for the
@@ -33,6 +36,7 @@ extern "C" {
                                                 ///< ODO_POSE_LIMIT_MM_Q32): its pose is held
 #define ODO_FAULT_POSE_XY_SATURATED (1UL << 19) ///< a truck's x or y beyond POSE_XY's +-21.47 km:
                                                 ///< the frame carries the saturated value
+// clang-format on
 
 #define ODO_FAULT_COUNT 20U
 

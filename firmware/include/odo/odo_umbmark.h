@@ -42,14 +42,14 @@ extern "C" {
 #endif
 
 /// Most runs accepted per direction (keeps every sum of squares inside 63 bits).
-#define ODO_UMB_MAX_RUNS 256U
+#define ODO_UMB_MAX_RUNS       256U
 /// Largest accepted |return error| component: 2^25 um = 33.554 m.
-#define ODO_UMB_MAX_ERR_UM ((int32_t)1 << 25)
+#define ODO_UMB_MAX_ERR_UM     ((int32_t)1 << 25)
 /// Largest accepted |orientation error|: 180 deg.
 #define ODO_UMB_MAX_THETA_UDEG 180000000
 /// Side length L of the square: [100 mm, 100 m].
-#define ODO_UMB_MIN_SIDE_UM 100000U
-#define ODO_UMB_MAX_SIDE_UM 100000000U
+#define ODO_UMB_MIN_SIDE_UM    100000U
+#define ODO_UMB_MAX_SIDE_UM    100000000U
 
 /// Direction index of the arrays below.
 #define ODO_UMB_CW  0U
@@ -57,12 +57,12 @@ extern "C" {
 
 typedef enum {
     ODO_UMB_OK = 0,
-    ODO_UMB_ERR_ARG,       ///< NULL pointer
-    ODO_UMB_ERR_FEW_RUNS,  ///< a direction with fewer than 2 runs, or more than ODO_UMB_MAX_RUNS
-    ODO_UMB_ERR_INPUT,     ///< a return error outside +-ODO_UMB_MAX_ERR_UM / +-180 deg
-    ODO_UMB_ERR_SIDE,      ///< side length outside [ODO_UMB_MIN_SIDE_UM, ODO_UMB_MAX_SIDE_UM]
-    ODO_UMB_ERR_GEOMETRY,  ///< wheelbase or current calibration outside the parameter block's range
-    ODO_UMB_ERR_RESULT     ///< the corrected Ed or Eb would leave the parameter block's [0.8, 1.25]
+    ODO_UMB_ERR_ARG,      ///< NULL pointer
+    ODO_UMB_ERR_FEW_RUNS, ///< a direction with fewer than 2 runs, or more than ODO_UMB_MAX_RUNS
+    ODO_UMB_ERR_INPUT,    ///< a return error outside +-ODO_UMB_MAX_ERR_UM / +-180 deg
+    ODO_UMB_ERR_SIDE,     ///< side length outside [ODO_UMB_MIN_SIDE_UM, ODO_UMB_MAX_SIDE_UM]
+    ODO_UMB_ERR_GEOMETRY, ///< wheelbase or current calibration outside the parameter block's range
+    ODO_UMB_ERR_RESULT    ///< the corrected Ed or Eb would leave the parameter block's [0.8, 1.25]
 } odo_umb_status_t;
 
 /// One run's return error (000 Eq. 3.1).
@@ -74,41 +74,41 @@ typedef struct {
 
 /// UMBmark statistics (000 Eqs. 3.2-3.4, s. 3.4 sigma, s. 6.3 SEM), index ODO_UMB_CW / _CCW.
 typedef struct {
-    uint16_t n[2];              ///< runs per direction
-    int32_t  cg_x_um[2];        ///< centre of gravity (Eq. 3.2), rounded to 1 um
-    int32_t  cg_y_um[2];
-    uint32_t r_cg_um[2];        ///< |cg| (Eq. 3.3)
-    uint32_t emax_syst_um;      ///< max(r_cg cw, r_cg ccw) (Eq. 3.4)
-    uint32_t sigma_um;          ///< pooled standard deviation about each cluster's own cg
-    uint32_t sem_um;            ///< sigma / sqrt(runs per direction)
-    int32_t  theta_bias_udeg[2];///< mean orientation error per direction (Eq. 3.6)
-    uint32_t avg_abs_theta_udeg;///< mean |etheta| over all runs (004 Eq. 17)
-    bool     second_pass_advised; ///< Emax,syst > 3 SEM (000 s. 6.3 rule of thumb)
+    uint16_t n[2];      ///< runs per direction
+    int32_t cg_x_um[2]; ///< centre of gravity (Eq. 3.2), rounded to 1 um
+    int32_t cg_y_um[2];
+    uint32_t r_cg_um[2];         ///< |cg| (Eq. 3.3)
+    uint32_t emax_syst_um;       ///< max(r_cg cw, r_cg ccw) (Eq. 3.4)
+    uint32_t sigma_um;           ///< pooled standard deviation about each cluster's own cg
+    uint32_t sem_um;             ///< sigma / sqrt(runs per direction)
+    int32_t theta_bias_udeg[2];  ///< mean orientation error per direction (Eq. 3.6)
+    uint32_t avg_abs_theta_udeg; ///< mean |etheta| over all runs (004 Eq. 17)
+    bool second_pass_advised;    ///< Emax,syst > 3 SEM (000 s. 6.3 rule of thumb)
 } odo_umb_stats_t;
 
 /// Compute the statistics of n_cw + n_ccw runs. Returns ODO_UMB_OK with *out filled, or an error
 /// with *out untouched: ERR_ARG (NULL), ERR_FEW_RUNS (a direction with < 2 or > ODO_UMB_MAX_RUNS
 /// runs), ERR_INPUT (a component out of range). O(n_cw + n_ccw).
-odo_umb_status_t odo_umb_stats(const odo_umb_return_t *cw, size_t n_cw, const odo_umb_return_t *ccw,
-                               size_t n_ccw, odo_umb_stats_t *out);
+odo_umb_status_t odo_umb_stats(const odo_umb_return_t *cw, size_t n_cw, const odo_umb_return_t *ccw, size_t n_ccw,
+                               odo_umb_stats_t *out);
 
 /// The paper's calibration (000 s. 6.1-6.2) from the statistics, for a firmware that ran the test
 /// with the calibration (ed_q30, eb_q30) already in its parameter block (1.0 for an uncalibrated
 /// robot); "a compensated robot can be treated as a new uncompensated robot" (000 s. 6.3), so the
 /// measured ratios multiply the current ones.
 typedef struct {
-    int32_t  alpha_x_bam, alpha_y_bam; ///< Eq. 6.26a (from x) and 6.26b (from y)
-    int32_t  beta_x_bam, beta_y_bam;   ///< Eq. 6.22a, 6.22b
-    int32_t  alpha_bam, beta_bam;      ///< the means used
-    uint32_t alpha_disagree_bam;       ///< |alpha_x - alpha_y|
-    uint32_t beta_disagree_bam;        ///< |beta_x - beta_y|
-    int64_t  radius_um;                ///< signed R of the leg's arc (Eq. 6.23); 0 iff beta == 0
-    int32_t  ed_meas_q30;              ///< Ed measured relative to the current calibration (Eq. 6.24)
-    int32_t  eb_meas_q30;              ///< Eb relative to the current calibration (Eq. 6.29)
-    int32_t  ed_q30;                   ///< new block value: current ed x ed_meas
-    int32_t  eb_q30;                   ///< new block value: current eb x eb_meas
-    uint32_t b_actual_nm;              ///< nominal wheelbase x new eb (Eq. 6.28)
-    int32_t  cl_q30, cr_q30;           ///< correction factors of the new Ed (Eqs. 6.33, 6.34)
+    int32_t alpha_x_bam, alpha_y_bam; ///< Eq. 6.26a (from x) and 6.26b (from y)
+    int32_t beta_x_bam, beta_y_bam;   ///< Eq. 6.22a, 6.22b
+    int32_t alpha_bam, beta_bam;      ///< the means used
+    uint32_t alpha_disagree_bam;      ///< |alpha_x - alpha_y|
+    uint32_t beta_disagree_bam;       ///< |beta_x - beta_y|
+    int64_t radius_um;                ///< signed R of the leg's arc (Eq. 6.23); 0 iff beta == 0
+    int32_t ed_meas_q30;              ///< Ed measured relative to the current calibration (Eq. 6.24)
+    int32_t eb_meas_q30;              ///< Eb relative to the current calibration (Eq. 6.29)
+    int32_t ed_q30;                   ///< new block value: current ed x ed_meas
+    int32_t eb_q30;                   ///< new block value: current eb x eb_meas
+    uint32_t b_actual_nm;             ///< nominal wheelbase x new eb (Eq. 6.28)
+    int32_t cl_q30, cr_q30;           ///< correction factors of the new Ed (Eqs. 6.33, 6.34)
 } odo_umb_calib_t;
 
 /// Paper method. side_um: L; wheelbase_nm: the nominal b of the parameter block (wheelbase_nm,
@@ -116,8 +116,8 @@ typedef struct {
 /// Returns ODO_UMB_OK with *out filled, or ERR_ARG, ERR_SIDE, ERR_GEOMETRY, ERR_RESULT (the result
 /// would not fit the parameter block; *out is then filled anyway, except ed/eb/cl/cr/b_actual,
 /// so a tool can say how far off it is). Constant time.
-odo_umb_status_t odo_umb_calibrate(const odo_umb_stats_t *s, uint32_t side_um, uint32_t wheelbase_nm,
-                                   int32_t ed_q30, int32_t eb_q30, odo_umb_calib_t *out);
+odo_umb_status_t odo_umb_calibrate(const odo_umb_stats_t *s, uint32_t side_um, uint32_t wheelbase_nm, int32_t ed_q30,
+                                   int32_t eb_q30, odo_umb_calib_t *out);
 
 /// cL = 2 / (Ed + 1) and cR = 2 / (1/Ed + 1) in Q30 (000 Eqs. 6.33, 6.34); the mean wheel diameter
 /// stays Da (Eq. 6.30). Returns false (outputs untouched) iff ed_q30 <= 0 or a pointer is NULL.
@@ -127,9 +127,8 @@ bool odo_umb_correction_factors(int32_t ed_q30, int32_t *cl_q30, int32_t *cr_q30
 /// (Eq. 3.5), each run's error taken relative to its direction's systematic bias from the plain
 /// UMBmark (Eq. 3.6: theta_bias_udeg of odo_umb_stats). Returns ODO_UMB_OK with *out_udeg, or
 /// ERR_ARG, ERR_FEW_RUNS (no run at all, or more than ODO_UMB_MAX_RUNS per direction), ERR_INPUT.
-odo_umb_status_t odo_umb_nonsys_theta(const odo_umb_return_t *cw, size_t n_cw,
-                                      const odo_umb_return_t *ccw, size_t n_ccw,
-                                      const int32_t theta_bias_udeg[2], uint32_t *out_udeg);
+odo_umb_status_t odo_umb_nonsys_theta(const odo_umb_return_t *cw, size_t n_cw, const odo_umb_return_t *ccw,
+                                      size_t n_ccw, const int32_t theta_bias_udeg[2], uint32_t *out_udeg);
 
 /// Static English text for a status.
 const char *odo_umb_status_str(odo_umb_status_t s);

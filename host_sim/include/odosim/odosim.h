@@ -23,38 +23,36 @@ typedef struct odosim_setup odosim_setup_t;
 
 /// One row per firmware tick (40 ms).
 typedef struct {
-    double   t_s;
-    double   truth[2][3];      ///< per truck: x_mm, y_mm, theta_rad (unwrapped), true
-    double   est[2][3];        ///< per truck: the firmware's published pose (theta in [-pi, pi))
-    double   link[3];          ///< true alpha_rad, beta_rad, l_mm (clapper/set; 0 for a labmate)
-    uint32_t counts[2][2];     ///< raw counter values the firmware read, [truck][left, right]
-    uint32_t faults;           ///< ODO_FAULT_* bits of the tick
-    uint32_t bump_events;      ///< discrete bumps first touched during this tick
+    double t_s;
+    double truth[2][3];    ///< per truck: x_mm, y_mm, theta_rad (unwrapped), true
+    double est[2][3];      ///< per truck: the firmware's published pose (theta in [-pi, pi))
+    double link[3];        ///< true alpha_rad, beta_rad, l_mm (clapper/set; 0 for a labmate)
+    uint32_t counts[2][2]; ///< raw counter values the firmware read, [truck][left, right]
+    uint32_t faults;       ///< ODO_FAULT_* bits of the tick
+    uint32_t bump_events;  ///< discrete bumps first touched during this tick
 } odosim_tick_row_t;
 
 typedef struct {
-    double   x_abs_mm, y_abs_mm, theta_abs_deg;    ///< true return pose of truck A
-    double   x_calc_mm, y_calc_mm, theta_calc_deg; ///< the firmware's
-    double   ex_mm, ey_mm, etheta_deg;             ///< 000 Eq. 3.1
-    double   t_end_s;
-    size_t   n_ticks;                              ///< ticks run (rows beyond capacity not stored)
+    double x_abs_mm, y_abs_mm, theta_abs_deg;    ///< true return pose of truck A
+    double x_calc_mm, y_calc_mm, theta_calc_deg; ///< the firmware's
+    double ex_mm, ey_mm, etheta_deg;             ///< 000 Eq. 3.1
+    double t_end_s;
+    size_t n_ticks; ///< ticks run (rows beyond capacity not stored)
 } odosim_result_t;
 
 /// ODOSIM_API_VERSION of the loaded library.
 int odosim_api_version(void);
 
 /// Read a robot description and a scenario from files (host_sim/robots, host_sim/scenarios).
-odosim_setup_t *odosim_setup_load(const char *robot_path, const char *scenario_path, char *err,
-                                  size_t errlen);
+odosim_setup_t *odosim_setup_load(const char *robot_path, const char *scenario_path, char *err, size_t errlen);
 
 /// The same from JSON text.
-odosim_setup_t *odosim_setup_parse(const char *robot_json, const char *scenario_json, char *err,
-                                   size_t errlen);
+odosim_setup_t *odosim_setup_parse(const char *robot_json, const char *scenario_json, char *err, size_t errlen);
 
 /// Switch an effect on and set one of its parameters (NULL param: just enable); truck_mask bit 0
 /// is truck A, bit 1 truck B. For sweeping candidates without files.
-int odosim_setup_set(odosim_setup_t *s, const char *effect, const char *param, unsigned truck_mask,
-                     double value, char *err, size_t errlen);
+int odosim_setup_set(odosim_setup_t *s, const char *effect, const char *param, unsigned truck_mask, double value,
+                     char *err, size_t errlen);
 
 /// Switch every effect off again (keeps the robot).
 void odosim_setup_clear(odosim_setup_t *s);
@@ -68,56 +66,56 @@ uint64_t odosim_run_seed(uint64_t base_seed, int ccw, unsigned run);
 /// One run of an experiment ("umbmark", "umbmark-ext", "straight-36m", "rect-7x4"); bumps < 0 for
 /// the experiment's default; ipec 0 off, 1 paper form, 2 estimator (else -1). Writes up to
 /// `capacity` rows (rows may be NULL). Returns 0.
-int odosim_run(const odosim_setup_t *s, const char *experiment, int ccw, int bumps, int ipec,
-               uint64_t seed, unsigned run_index, odosim_tick_row_t *rows, size_t capacity,
-               odosim_result_t *result, char *err, size_t errlen);
+int odosim_run(const odosim_setup_t *s, const char *experiment, int ccw, int bumps, int ipec, uint64_t seed,
+               unsigned run_index, odosim_tick_row_t *rows, size_t capacity, odosim_result_t *result, char *err,
+               size_t errlen);
 
 /// Options of odosim_run_ex. Zero-initialise, then set what you need: zero hidden fields are off,
 /// physics_dt_s 0 is 1 ms, bump_height_mm 0 is 10 mm.
 typedef struct {
-    const char *experiment;      ///< as odosim_run
-    int         ccw;
-    int         bumps;           ///< < 0: the experiment's default
-    double      bump_height_mm;  ///< height of the experiment's bumps (0: 10 mm)
-    int         ipec;
-    uint64_t    seed;
-    unsigned    run_index;
-    double      physics_dt_s;    ///< 0: 1 ms
+    const char *experiment; ///< as odosim_run
+    int ccw;
+    int bumps;             ///< < 0: the experiment's default
+    double bump_height_mm; ///< height of the experiment's bumps (0: 10 mm)
+    int ipec;
+    uint64_t seed;
+    unsigned run_index;
+    double physics_dt_s; ///< 0: 1 ms
     /* Hidden (out-of-catalog) truth, host_sim/src/world.h sim_hidden_t; not in any scenario. */
-    double      motor_tau_s;       ///< wheel speed lags its command (controller dynamics)
-    double      diam_var_amp;      ///< D(t) = D (1 + amp sin(2 pi t / T) + drift t)
-    double      diam_var_period_s; ///< T
-    double      diam_drift_per_s;  ///< drift
-    double      backlash_rad;      ///< gear backlash at the wheel
+    double motor_tau_s;       ///< wheel speed lags its command (controller dynamics)
+    double diam_var_amp;      ///< D(t) = D (1 + amp sin(2 pi t / T) + drift t)
+    double diam_var_period_s; ///< T
+    double diam_drift_per_s;  ///< drift
+    double backlash_rad;      ///< gear backlash at the wheel
 } odosim_run_opts_t;
 
 /// One row per firmware tick with what the sensors put on the bus (for writing "real" logs).
 typedef struct {
-    double   t_s;
-    uint64_t t_us;             ///< sample time the firmware read (the frames' timestamp)
-    double   truth[2][3];      ///< per truck: x_mm, y_mm, theta_rad (unwrapped), true
-    double   link_true[3];     ///< true alpha_rad, beta_rad, l_mm
-    uint32_t counts[2][2];     ///< raw counter values, [truck][left, right]
-    uint8_t  wheel_seq[2], wheel_status[2], wheel_present[2];
-    uint8_t  rotary_present, linear_present, rotary_status, linear_status;
-    uint8_t  rotary_seq, linear_seq;
+    double t_s;
+    uint64_t t_us;         ///< sample time the firmware read (the frames' timestamp)
+    double truth[2][3];    ///< per truck: x_mm, y_mm, theta_rad (unwrapped), true
+    double link_true[3];   ///< true alpha_rad, beta_rad, l_mm
+    uint32_t counts[2][2]; ///< raw counter values, [truck][left, right]
+    uint8_t wheel_seq[2], wheel_status[2], wheel_present[2];
+    uint8_t rotary_present, linear_present, rotary_status, linear_status;
+    uint8_t rotary_seq, linear_seq;
     uint16_t alpha_bam16, beta_bam16; ///< linkage encoders as read (bias, quantisation applied)
     uint32_t length_um;
-    uint32_t n_events;         ///< bump events first touched during this tick
+    uint32_t n_events; ///< bump events first touched during this tick
 } odosim_tick_row_ex_t;
 
 /// A discrete bump event (first contact).
 typedef struct {
-    double   t_s, x_mm, y_mm, height_mm, at_distance_mm;
-    uint32_t truck, wheel;     ///< 0 A / 1 B; 0 left / 1 right
+    double t_s, x_mm, y_mm, height_mm, at_distance_mm;
+    uint32_t truck, wheel; ///< 0 A / 1 B; 0 left / 1 right
 } odosim_event_t;
 
 /// odosim_run with options (hidden effects, physics step) and sensor-level rows; events (may be
 /// NULL) receives up to ev_capacity bump events, *n_events (may be NULL) their total. Returns 0,
 /// or -1 with a message (also for bad hidden values).
-int odosim_run_ex(const odosim_setup_t *s, const odosim_run_opts_t *opts, odosim_tick_row_ex_t *rows,
-                  size_t capacity, odosim_event_t *events, size_t ev_capacity, size_t *n_events,
-                  odosim_result_t *result, char *err, size_t errlen);
+int odosim_run_ex(const odosim_setup_t *s, const odosim_run_opts_t *opts, odosim_tick_row_ex_t *rows, size_t capacity,
+                  odosim_event_t *events, size_t ev_capacity, size_t *n_events, odosim_result_t *result, char *err,
+                  size_t errlen);
 
 /// The effects catalog as a JSON document (malloc'd; release with odosim_free), or NULL.
 char *odosim_effects_json(void);

@@ -59,7 +59,7 @@ START_TEST(raw_image_block_is_found_among_decoys_and_patched_in_place)
     ck_assert_int_eq(m.status, ODO_PARAMS_OK);
     uint8_t nb[ODO_PARAMS_SIZE];
     block_with(nb, (int32_t)(1.001 * (1 << 30)));
-    ck_assert_msg(img_write_patched(&m, nb, out, err, sizeof err) == 0, "%s", err);
+    ck_assert_msg(img_write_patched(&m, nb, out, NULL, err, sizeof err) == 0, "%s", err);
     img_free(&m);
     ck_assert_uint_eq(get(out, back, sizeof back), sizeof img);
     ck_assert_mem_eq(back, img, 0x4000);
@@ -84,8 +84,8 @@ START_TEST(raw_image_refusals_name_the_problem)
 
     img[0x104] = 3; /* version 3, CRC recomputed: another layout */
     const uint32_t crc = odo_crc32(img + 0x100, ODO_PARAMS_CRC_OFFSET);
-    for (int k = 0; k < 4; ++k) {
-        img[0x100 + ODO_PARAMS_CRC_OFFSET + k] = (uint8_t)(crc >> (8 * k));
+    for (unsigned k = 0; k < 4U; ++k) {
+        img[0x100 + ODO_PARAMS_CRC_OFFSET + k] = (uint8_t)(crc >> (8U * k));
     }
     put(path, img, sizeof img);
     ck_assert_int_eq(img_load(path, &m, err, sizeof err), -1);
@@ -110,7 +110,7 @@ START_TEST(raw_image_refusals_name_the_problem)
     ck_assert_msg(img_load(path, &m, err, sizeof err) == 0, "%s", err);
     uint8_t nb[ODO_PARAMS_SIZE];
     block_with(nb, 1 << 30);
-    ck_assert_int_eq(img_write_patched(&m, nb, "/proc/odo-calib-readonly.bin", err, sizeof err), -1);
+    ck_assert_int_eq(img_write_patched(&m, nb, "/proc/odo-calib-readonly.bin", NULL, err, sizeof err), -1);
     ck_assert_msg(strstr(err, "cannot create") != NULL, "%s", err);
     img_free(&m);
 }
@@ -156,7 +156,7 @@ START_TEST(intel_hex_records_straddling_the_block_are_patched_with_new_checksums
     ck_assert_uint_eq(m.block_addr, 0x08004000);
     uint8_t nb[ODO_PARAMS_SIZE];
     block_with(nb, (int32_t)(0.999 * (1 << 30)));
-    ck_assert_msg(img_write_patched(&m, nb, out, err, sizeof err) == 0, "%s", err);
+    ck_assert_msg(img_write_patched(&m, nb, out, NULL, err, sizeof err) == 0, "%s", err);
     img_free(&m);
     img_t m2;
     ck_assert_msg(img_load(out, &m2, err, sizeof err) == 0, "%s", err); /* checksums verified on load */
@@ -217,7 +217,7 @@ START_TEST(version_1_images_read_but_are_never_written)
     ck_assert_int_eq(m.status, ODO_PARAMS_OK);
     uint8_t nb[ODO_PARAMS_SIZE];
     block_with(nb, 1 << 30);
-    ck_assert_int_eq(img_write_patched(&m, nb, out, err, sizeof err), -1);
+    ck_assert_int_eq(img_write_patched(&m, nb, out, NULL, err, sizeof err), -1);
     ck_assert_msg(strstr(err, "version-1 parameter block (128 bytes)") != NULL, "%s", err);
     img_free(&m);
     ck_assert_int_eq(access(out, F_OK), -1);
@@ -243,7 +243,7 @@ START_TEST(version_1_images_read_but_are_never_written)
     ck_assert_msg(img_load(path, &m, err, sizeof err) == 0, "%s", err);
     ck_assert_uint_eq(m.version, 1);
     ck_assert_uint_eq(m.block_addr, 0x08004000);
-    ck_assert_int_eq(img_write_patched(&m, nb, out, err, sizeof err), -1);
+    ck_assert_int_eq(img_write_patched(&m, nb, out, NULL, err, sizeof err), -1);
     img_free(&m);
 }
 END_TEST

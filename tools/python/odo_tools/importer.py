@@ -22,10 +22,12 @@ tick_ms: the robot JSON states the cycle, so a 50 ms robot gets "tick_ms": 50 ra
 resampling that would invent counts.
 
 Every bad input (mismatched ticks/truth lengths, time going backwards, a map naming a missing
-column, a cycle or robot that does not match) is one line naming the file and line, exit code 1,
-and nothing written. Output goes to a temporary folder beside OUT that is renamed into place; an
-existing OUT is replaced only if odo-import wrote it (marker file .odo-import), and OUT may not be
-an input.
+column, a cycle or robot that does not match, a file that is not UTF-8 text) is one line naming
+the file and line, exit code 1, and nothing written. OUT follows the output rule
+(odo_tools/outpath.py): built in a temporary folder beside it and put into place at the end;
+missing parents are created; an existing OUT must be empty or a previous odo-import output (its
+.odo-manifest: only the files listed there are replaced or removed) unless --force, which writes
+into it and removes nothing; OUT may not be an input nor lie inside an input folder.
 """
 
 from __future__ import annotations
@@ -33,8 +35,8 @@ from __future__ import annotations
 import argparse
 import csv
 import ctypes as C
+import io
 import math
-import os
 import shutil
 import sys
 from pathlib import Path
@@ -43,8 +45,8 @@ import numpy as np
 
 from .gap.errors import GapInputError
 from .gap.io import encode_payload, read_robot, write_candump
+from .outpath import OutDir, OutputError
 
-MARKER = ".odo-import"
 RET_HEADER = "run,direction,x_abs_mm,y_abs_mm,theta_abs_deg,x_calc_mm,y_calc_mm,theta_calc_deg\n"
 
 
@@ -68,11 +70,19 @@ def read_table(
 ) -> dict[str, np.ndarray]:
     """A CSV as role -> column: header-less with `columns`, else the header renamed by `mapping`."""
     try:
-        f = path.open(newline="")
+        raw = path.read_bytes()
     except OSError as e:
         raise GapInputError(path, f"cannot read: {e.strerror}") from None
-    with f:
-        rows = list(csv.reader(f))
+    try:
+        text = raw.decode("utf-8-sig")
+    except UnicodeDecodeError as e:
+        line = raw[: e.start].count(b"\n") + 1
+        raise GapInputError(path, f"not UTF-8 text (byte 0x{raw[e.start]:02x})", line) from None
+    reader = csv.reader(io.StringIO(text, newline=""))
+    try:
+        rows = list(reader)
+    except csv.Error as e:
+        raise GapInputError(path, f"not a CSV table: {e}", reader.line_num) from None
     if not rows:
         raise GapInputError(path, "empty file")
     start = 0
@@ -311,7 +321,9 @@ def expand(items: list[str]) -> list[tuple[str | None, list[Path]]]:
     return out
 
 
-def import_set(a: argparse.Namespace, files: list[Path], truths: list[Path] | None, dst: Path):
+def import_set(
+    a: argparse.Namespace, files: list[Path], truths: list[Path] | None, dst: Path, label: str
+):
     cols = a.columns.split(",") if a.columns else None
     tcols = a.truth_columns.split(",") if a.truth_columns else cols
     mapping = parse_map(a.map)
@@ -322,7 +334,7 @@ def import_set(a: argparse.Namespace, files: list[Path], truths: list[Path] | No
         )
     seen: dict[str, int] = {}
     rets = []
-    dst.mkdir()
+    dst.mkdir(exist_ok=True)
     for i, f in enumerate(files):
         d = dirs[i]
         seen[d] = seen.get(d, 0) + 1
@@ -345,23 +357,10 @@ def import_set(a: argparse.Namespace, files: list[Path], truths: list[Path] | No
             cx, cy, cth = calc
             cth = (cth + 180.0) % 360.0 - 180.0
             rets.append(f"{seen[d]},{d},{x:.3f},{y:.3f},{th:.4f},{cx:.3f},{cy:.3f},{cth:.4f}")
-        print(f"odo-import: {f} -> {dst.name}/{base.name}", file=sys.stderr)
+        print(f"odo-import: {f} -> {label}/{base.name}", file=sys.stderr)
     if rets:
         (dst / "returns.csv").write_text(RET_HEADER + "\n".join(rets) + "\n")
     shutil.copy(a.robot, dst / "robot.json")
-    (dst / MARKER).write_text("written by odo-import; it replaces this folder on a re-import\n")
-
-
-def finish(out: Path, tmp: Path) -> None:
-    """Rename tmp/final into place; an earlier odo-import output (marker checked) is replaced."""
-    if out.exists():
-        old = out.with_name(out.name + f".old.{os.getpid()}")
-        out.rename(old)
-        (tmp / "final").rename(out)
-        shutil.rmtree(old)
-    else:
-        (tmp / "final").rename(out)
-    shutil.rmtree(tmp)
 
 
 def rosbag_doc() -> str:
@@ -381,7 +380,7 @@ def import_bags(a: argparse.Namespace, dst: Path) -> None:
     dirs = a.directions.split(",") if a.directions else ["fwd"] * len(a.bag)
     if len(dirs) != len(a.bag):
         raise ValueError(f"--directions has {len(dirs)} entries for {len(a.bag)} bags")
-    dst.mkdir()
+    dst.mkdir(exist_ok=True)
     seen: dict[str, int] = {}
     rets = []
     for i, bag in enumerate(a.bag):
@@ -410,7 +409,6 @@ def import_bags(a: argparse.Namespace, dst: Path) -> None:
     if rets:
         (dst / "returns.csv").write_text(RET_HEADER + "\n".join(rets) + "\n")
     shutil.copy(a.robot, dst / "robot.json")
-    (dst / MARKER).write_text("written by odo-import; it replaces this folder on a re-import\n")
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -445,7 +443,8 @@ def main(argv: list[str] | None = None) -> int:
     )
     t.add_argument("--cumulative", action="store_true", help="ticks are running totals")
     t.add_argument("--directions", help="comma list of run directions (cw/ccw/fwd), one per run")
-    t.add_argument("--out", required=True, help="new folder (several input folders: one each)")
+    t.add_argument("--out", required=True, help="output folder (several input folders: one each)")
+    t.add_argument("--force", action="store_true", help="write into a non-empty foreign folder")
     b = sub.add_parser(
         "ros2-bag",
         help="ROS 2 bags (JointState wheels + Odometry/PoseStamped truth) -> candump + truth CSV",
@@ -460,52 +459,47 @@ def main(argv: list[str] | None = None) -> int:
     )
     b.add_argument("--truth-topic", help="nav_msgs/Odometry or geometry_msgs/PoseStamped topic")
     b.add_argument("--directions", help="comma list of run directions (cw/ccw/fwd), one per run")
-    b.add_argument("--out", required=True, help="new folder")
+    b.add_argument("--out", required=True, help="output folder")
+    b.add_argument("--force", action="store_true", help="write into a non-empty foreign folder")
     a = ap.parse_args(argv)
-    out = Path(a.out)
-    tmp = out.with_name(out.name + f".tmp.{os.getpid()}")
     try:
-        srcs = a.ticks + (a.truth or []) if a.cmd == "ticks-csv" else a.bag
-        inputs = [Path(p).resolve() for p in [*srcs, a.robot]]
-        if out.resolve() in inputs or any(out.resolve() in p.parents for p in inputs):
-            raise GapInputError(out, "--out is (or holds) an input; choose a new folder")
-        if out.exists() and not (out / MARKER).is_file():
-            raise GapInputError(
-                out, "exists and was not written by odo-import; choose a new folder"
-            )
-        if a.cmd == "ros2-bag":
-            tmp.mkdir(parents=True)
-            import_bags(a, tmp / "final")
-            finish(out, tmp)
-            return 0
-        if a.map and a.columns:
-            ap.error("--map names header columns, --columns header-less ones: give one")
-        sets = expand(a.ticks)
-        truths = [Path(p) for p in a.truth] if a.truth else None
-        if truths is not None and (len(sets) != 1 or len(truths) != len(sets[0][1])):
-            ap.error("--truth needs one file per --ticks file (folders: keep the truth in them)")
-        tmp.mkdir(parents=True)
-        if len(sets) == 1:
-            import_set(a, sets[0][1], truths, tmp / "run")
-            (tmp / "run").rename(tmp / "final")
+        if a.cmd == "ticks-csv":
+            if a.map and a.columns:
+                ap.error("--map names header columns, --columns header-less ones: give one")
+            check_truth_units(a.truth_units)
+            srcs = [*a.ticks, *(a.truth or [])]
         else:
-            (tmp / "final").mkdir()
-            for name, files in sets:
-                import_set(a, files, None, tmp / "final" / (name or "files"))
-            (tmp / "final" / MARKER).write_text("written by odo-import\n")
-        finish(out, tmp)
+            srcs = list(a.bag)
+        with OutDir(a.out, "odo-import", a.force, [*srcs, a.robot]) as out:
+            if a.cmd == "ros2-bag":
+                import_bags(a, out.tmp)
+                return 0
+            sets = expand(a.ticks)
+            truths = [Path(p) for p in a.truth] if a.truth else None
+            if truths is not None and (len(sets) != 1 or len(truths) != len(sets[0][1])):
+                ap.error(
+                    "--truth needs one file per --ticks file (folders: keep the truth in them)"
+                )
+            if len(sets) == 1:
+                import_set(a, sets[0][1], truths, out.tmp, a.out)
+            else:
+                for name, files in sets:
+                    sub = name or "files"
+                    import_set(a, files, None, out.tmp / sub, f"{a.out}/{sub}")
         return 0
-    except GapInputError as e:
-        shutil.rmtree(tmp, ignore_errors=True)
+    except (GapInputError, OutputError, ValueError) as e:
         print(f"odo-import: {e}", file=sys.stderr)
         return 1
-    except ValueError as e:
-        shutil.rmtree(tmp, ignore_errors=True)
-        print(f"odo-import: {e}", file=sys.stderr)
+    except OSError as e:
+        print(f"odo-import: {e.filename or ''}: {e.strerror or e}", file=sys.stderr)
         return 1
-    except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
-        raise
+
+
+def check_truth_units(units: str) -> None:
+    """--truth-units LIN,ANG with LIN m|mm and ANG rad|deg."""
+    parts = units.split(",")
+    if len(parts) != 2 or parts[0] not in ("m", "mm") or parts[1] not in ("rad", "deg"):
+        raise ValueError(f"--truth-units must be m|mm,rad|deg (e.g. mm,deg), not '{units}'")
 
 
 if __name__ == "__main__":

@@ -17,16 +17,31 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
+from .outpath import OutputError
 from .plotstyle import LEGEND_PT, TITLE_PT, save_png
 
 
 def read_pose(path: Path) -> dict[str, np.ndarray]:
     """Columns of an odo-demo pose.csv as float arrays, keyed by header name."""
-    with path.open(newline="") as f:
-        rows = list(csv.reader(f))
+    try:
+        with path.open(newline="", encoding="utf-8") as f:
+            rows = list(csv.reader(f))
+    except UnicodeDecodeError as e:
+        line = path.read_bytes()[: e.start].count(b"\n") + 1
+        raise ValueError(f"{path}:{line}: not UTF-8 text") from None
     if len(rows) < 2:
         raise ValueError(f"{path}: no data rows")
+    for i, r in enumerate(rows[1:], start=2):
+        if len(r) != len(rows[0]):
+            raise ValueError(f"{path}:{i}: {len(r)} fields, expected {len(rows[0])}")
+        try:
+            [float(x) for x in r]
+        except ValueError:
+            raise ValueError(f"{path}:{i}: not a number") from None
     header, data = rows[0], np.array(rows[1:], dtype=float)
+    for need in ("x_mm", "y_mm", "true_x_mm", "true_y_mm"):
+        if need not in header:
+            raise ValueError(f"{path}:1: no column {need} (an odo-demo pose.csv?)")
     return {name: data[:, i] for i, name in enumerate(header)}
 
 
@@ -81,8 +96,7 @@ def figure(runs: dict[str, Path]) -> plt.Figure:
 
 
 def plot(runs: dict[str, Path], out: Path) -> None:
-    out.parent.mkdir(parents=True, exist_ok=True)
-    save_png(figure(runs), out)
+    save_png(figure(runs), out, runs.values())
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -105,7 +119,7 @@ def main(argv: list[str] | None = None) -> int:
         runs[name] = Path(path)
     try:
         plot(runs, args.out)
-    except (OSError, ValueError) as e:
+    except (OSError, ValueError, OutputError) as e:
         print(f"odo-plot-demo: {e}", file=sys.stderr)
         return 1
     print(f"odo-plot-demo: wrote {args.out}")

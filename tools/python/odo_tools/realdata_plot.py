@@ -22,6 +22,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
+from .outpath import OutputError
 from .plotstyle import LEGEND_PT, TITLE_PT, save_png
 
 
@@ -133,7 +134,7 @@ def main(argv: list[str] | None = None) -> int:
         metavar="NAME=TRUTH,BEFORE,AFTER",
         help="a panel: name, the run's truth CSV, odo-replay poses.csv before and after",
     )
-    ap.add_argument("--out", required=True, help="PNG to write (temporary file, then renamed)")
+    ap.add_argument("--out", required=True, help="PNG to write (a temp beside it, then renamed)")
     a = ap.parse_args(argv)
     panels = []
     for spec in a.run:
@@ -143,9 +144,11 @@ def main(argv: list[str] | None = None) -> int:
             ap.error(f"--run {spec!r}: expected NAME=TRUTH,BEFORE,AFTER")
         panels.append((name, *(Path(p) for p in parts)))
     out = Path(a.out)
-    if out.resolve() in [p.resolve() for pn in panels for p in pn[1:]]:
-        ap.error("--out is one of the inputs")
-    save_png(figure(panels), out)
+    try:  # the output rule (odo_tools/outpath.py): temp beside it, renamed; never an input
+        save_png(figure(panels), out, [p for pn in panels for p in pn[1:]])
+    except (OutputError, OSError) as e:
+        print(f"odo-plot-realdata: {e}", file=sys.stderr)
+        return 1
     print(f"odo-plot-realdata: wrote {out}", file=sys.stderr)
     return 0
 

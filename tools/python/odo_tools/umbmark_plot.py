@@ -21,6 +21,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.patches import Rectangle
 
+from .outpath import OutputError
 from .plotstyle import LEGEND_PT, TITLE_PT, save_png
 
 COLUMNS = [
@@ -37,8 +38,14 @@ COLUMNS = [
 
 def read_returns(path: Path) -> dict[str, np.ndarray]:
     """Return errors (000 Eq. 3.1) per direction: {"cw": (n, 2) array of (ex, ey) mm, ...}."""
-    with path.open(newline="") as f:
-        rows = [r for r in csv.reader(f) if r and not r[0].startswith("#")]
+    try:
+        with path.open(newline="", encoding="utf-8") as f:
+            rows = [r for r in csv.reader(f) if r and not r[0].startswith("#")]
+    except UnicodeDecodeError as e:
+        line = path.read_bytes()[: e.start].count(b"\n") + 1
+        raise ValueError(f"{path}:{line}: not UTF-8 text") from None
+    except csv.Error as e:
+        raise ValueError(f"{path}: not a CSV table: {e}") from None
     if not rows or rows[0] != COLUMNS:
         raise ValueError(f"{path}:1: header must be {','.join(COLUMNS)}")
     out: dict[str, list[tuple[float, float]]] = {"cw": [], "ccw": []}
@@ -52,6 +59,8 @@ def read_returns(path: Path) -> dict[str, np.ndarray]:
         if not np.all(np.isfinite(v)):
             raise ValueError(f"{path}:{lineno}: values must be finite")
         out[r[1]].append((v[0] - v[3], v[1] - v[4]))
+    if not out["cw"] and not out["ccw"]:
+        raise ValueError(f"{path}: no runs (a header and no rows)")
     return {d: np.array(p, dtype=float).reshape(-1, 2) for d, p in out.items()}
 
 
@@ -170,9 +179,12 @@ def main(argv: list[str] | None = None) -> int:
         print(f"odo-plot-umbmark: {e}", file=sys.stderr)
         return 1
     try:
-        save_png(figure(before, after, args.title), args.out)
+        save_png(figure(before, after, args.title), args.out, [args.before, args.after])
+    except OutputError as e:
+        print(f"odo-plot-umbmark: {e}", file=sys.stderr)
+        return 1
     except OSError as e:
-        print(f"odo-plot-umbmark: cannot write {args.out}: {e}", file=sys.stderr)
+        print(f"odo-plot-umbmark: cannot write {args.out}: {e.strerror or e}", file=sys.stderr)
         return 1
     line = f"Emax,syst before {emax_syst(before):.1f} mm"
     if after is not None:

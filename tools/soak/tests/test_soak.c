@@ -28,14 +28,15 @@ START_TEST(twenty_percent_frame_loss_at_speed_loses_under_one_percent_of_travel)
             const double lost_pct = 100.0 * (r.end_x_clean_mm - r.end_x_faulty_mm) / r.end_x_clean_mm;
             if (s == 0U) {
                 printf("%.1f m/s, 20 %% lost (%" PRIu64 " of %" PRIu64 " frames): %.3f of %.3f m travelled, "
-                       "%.6f %% lost\n", speeds[v] / 1000.0, r.dropped, r.frames_sent, r.end_x_faulty_mm / 1000.0,
+                       "%.6f %% lost\n",
+                       speeds[v] / 1000.0, r.dropped, r.frames_sent, r.end_x_faulty_mm / 1000.0,
                        r.end_x_clean_mm / 1000.0, lost_pct);
             }
             ck_assert_double_gt(r.end_x_clean_mm, 0.99 * speeds[v] * 40.0 - speeds[v] * 0.04);
             ck_assert_uint_gt(r.dropped, 150U);
-            ck_assert_uint_gt(r.fault_ticks[5], 100U);  /* SEQ_GAP flagged */
-            ck_assert_uint_eq(r.fault_ticks[1], 0U);    /* no COUNTER_JUMP_A */
-            ck_assert_double_lt(fabs(lost_pct), 1.0);   /* the acceptance */
+            ck_assert_uint_gt(r.fault_ticks[5], 100U);                             /* SEQ_GAP flagged */
+            ck_assert_uint_eq(r.fault_ticks[1], 0U);                               /* no COUNTER_JUMP_A */
+            ck_assert_double_lt(fabs(lost_pct), 1.0);                              /* the acceptance */
             ck_assert_double_lt(fabs(r.end_x_clean_mm - r.end_x_faulty_mm), 1e-3); /* and in fact */
         }
     }
@@ -52,8 +53,8 @@ START_TEST(a_short_soak_of_every_fault_stays_with_the_clean_run)
     ck_assert_int_eq(soak_run(&c, &r, NULL, NULL), 0);
     printf("soak %" PRIu64 " ticks: path %.3f km, end %.4f mm / %.7f deg, worst %.4f mm, lag %.1f mm, "
            "%" PRIu64 " dropped, %" PRIu64 " dup, %" PRIu64 " reordered, %" PRIu64 " bursts, jumps %" PRIu64 "\n",
-           c.ticks, r.path_m / 1000.0, r.end_pos_err_mm, r.end_heading_err_deg,
-           r.max_pos_err_mm, r.max_lag_mm, r.dropped, r.duplicated, r.reordered, r.bursts, r.fault_ticks[1]);
+           c.ticks, r.path_m / 1000.0, r.end_pos_err_mm, r.end_heading_err_deg, r.max_pos_err_mm, r.max_lag_mm,
+           r.dropped, r.duplicated, r.reordered, r.bursts, r.fault_ticks[1]);
     ck_assert_uint_eq(r.ticks_faulty, r.ticks_clean); /* the clock step folded no ticks */
     ck_assert_uint_eq(r.clock_steps, 1U);
     /* TIME_BACKWARDS: every reordered frame (stamped before the one swapped ahead of it), plus
@@ -64,8 +65,8 @@ START_TEST(a_short_soak_of_every_fault_stays_with_the_clean_run)
     ck_assert_uint_gt(r.duplicated, c.ticks / 40U);
     ck_assert_uint_gt(r.reordered, c.ticks / 100U);
     ck_assert_uint_gt(r.bursts, 10U);
-    ck_assert_uint_gt(r.fault_ticks[16], 10U);        /* BUS_ERROR */
-    ck_assert_uint_eq(r.fault_ticks[1], 0U);          /* no sample thrown away */
+    ck_assert_uint_gt(r.fault_ticks[16], 10U); /* BUS_ERROR */
+    ck_assert_uint_eq(r.fault_ticks[1], 0U);   /* no sample thrown away */
     ck_assert_double_gt(r.path_m, 1000.0);
     ck_assert_double_lt(r.end_pos_err_mm, BOUND_END_MM);
     ck_assert_double_lt(fabs(r.end_heading_err_deg), BOUND_END_DEG);
