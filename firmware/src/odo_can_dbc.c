@@ -2,14 +2,18 @@
 /// The unpackers, the layout tables (odo_can_msg_info), classification by identifier and the
 /// signal-order adapters of odo/odo_can.h. The image links only what it calls (the sensor frames'
 /// unpackers, classify); the tables and adapters serve host tools and tests.
-// clang-format off: generated code, laid out by cangen.py
+// clang-format off
 #include "odo/odo_can.h"
 
 /// The two's-complement reading of a 32-bit pattern, without implementation-defined
 /// conversion.
-static int32_t odo_can_as_s32_(uint32_t u) { return u <= (uint32_t)INT32_MAX ? (int32_t)u : -(int32_t)(~u) - 1; }
+static int32_t odo_can_as_s32_(uint32_t u)
+{
+    return u <= (uint32_t)INT32_MAX ? (int32_t)u : -(int32_t)(~u) - 1;
+}
 
-odo_can_result_t odo_can_unpack_wheel_counts(const odo_can_frame_t *f, uint8_t *truck, odo_msg_wheel_counts_t *m)
+odo_can_result_t odo_can_unpack_wheel_counts(const odo_can_frame_t *f, uint8_t *truck,
+                                             odo_msg_wheel_counts_t *m)
 {
     if ((f->flags & ODO_CAN_FLAGS_NOT_OURS) != 0U) {
         return ODO_CAN_ERR_FLAGS;
@@ -26,8 +30,10 @@ odo_can_result_t odo_can_unpack_wheel_counts(const odo_can_frame_t *f, uint8_t *
         return ODO_CAN_ERR_DLC;
     }
     *truck = which;
-    m->left_count = (uint32_t)((uint32_t)f->data[0] | ((uint32_t)f->data[1] << 8U) | ((uint32_t)f->data[2] << 16U));
-    m->right_count = (uint32_t)((uint32_t)f->data[3] | ((uint32_t)f->data[4] << 8U) | ((uint32_t)f->data[5] << 16U));
+    m->left_count = (uint32_t)((uint32_t)f->data[0] | ((uint32_t)f->data[1] << 8U) |
+        ((uint32_t)f->data[2] << 16U));
+    m->right_count = (uint32_t)((uint32_t)f->data[3] | ((uint32_t)f->data[4] << 8U) |
+        ((uint32_t)f->data[5] << 16U));
     m->seq = (uint8_t)((uint32_t)f->data[6]);
     m->status = (uint8_t)((uint32_t)f->data[7]);
     return ODO_CAN_OK;
@@ -62,14 +68,15 @@ odo_can_result_t odo_can_unpack_link_linear(const odo_can_frame_t *f, odo_msg_li
     if (f->dlc != ODO_CAN_DLC_LINK_LINEAR) {
         return ODO_CAN_ERR_DLC;
     }
-    m->length_um = (uint32_t)((uint32_t)f->data[0] | ((uint32_t)f->data[1] << 8U) | ((uint32_t)f->data[2] << 16U) |
-                              ((uint32_t)f->data[3] << 24U));
+    m->length_um = (uint32_t)((uint32_t)f->data[0] | ((uint32_t)f->data[1] << 8U) |
+        ((uint32_t)f->data[2] << 16U) | ((uint32_t)f->data[3] << 24U));
     m->seq = (uint8_t)((uint32_t)f->data[4]);
     m->status = (uint8_t)((uint32_t)f->data[5]);
     return ODO_CAN_OK;
 }
 
-odo_can_result_t odo_can_unpack_pose_xy(const odo_can_frame_t *f, uint8_t *truck, odo_msg_pose_xy_t *m)
+odo_can_result_t odo_can_unpack_pose_xy(const odo_can_frame_t *f, uint8_t *truck,
+                                        odo_msg_pose_xy_t *m)
 {
     if ((f->flags & ODO_CAN_FLAGS_NOT_OURS) != 0U) {
         return ODO_CAN_ERR_FLAGS;
@@ -86,14 +93,15 @@ odo_can_result_t odo_can_unpack_pose_xy(const odo_can_frame_t *f, uint8_t *truck
         return ODO_CAN_ERR_DLC;
     }
     *truck = which;
-    m->x_10um = odo_can_as_s32_((uint32_t)f->data[0] | ((uint32_t)f->data[1] << 8U) | ((uint32_t)f->data[2] << 16U) |
-                                ((uint32_t)f->data[3] << 24U));
-    m->y_10um = odo_can_as_s32_((uint32_t)f->data[4] | ((uint32_t)f->data[5] << 8U) | ((uint32_t)f->data[6] << 16U) |
-                                ((uint32_t)f->data[7] << 24U));
+    m->x_10um = odo_can_as_s32_((uint32_t)f->data[0] | ((uint32_t)f->data[1] << 8U) |
+        ((uint32_t)f->data[2] << 16U) | ((uint32_t)f->data[3] << 24U));
+    m->y_10um = odo_can_as_s32_((uint32_t)f->data[4] | ((uint32_t)f->data[5] << 8U) |
+        ((uint32_t)f->data[6] << 16U) | ((uint32_t)f->data[7] << 24U));
     return ODO_CAN_OK;
 }
 
-odo_can_result_t odo_can_unpack_pose_theta(const odo_can_frame_t *f, uint8_t *truck, odo_msg_pose_theta_t *m)
+odo_can_result_t odo_can_unpack_pose_theta(const odo_can_frame_t *f, uint8_t *truck,
+                                           odo_msg_pose_theta_t *m)
 {
     if ((f->flags & ODO_CAN_FLAGS_NOT_OURS) != 0U) {
         return ODO_CAN_ERR_FLAGS;
@@ -110,8 +118,8 @@ odo_can_result_t odo_can_unpack_pose_theta(const odo_can_frame_t *f, uint8_t *tr
         return ODO_CAN_ERR_DLC;
     }
     *truck = which;
-    m->theta_bam = (uint32_t)((uint32_t)f->data[0] | ((uint32_t)f->data[1] << 8U) | ((uint32_t)f->data[2] << 16U) |
-                              ((uint32_t)f->data[3] << 24U));
+    m->theta_bam = (uint32_t)((uint32_t)f->data[0] | ((uint32_t)f->data[1] << 8U) |
+        ((uint32_t)f->data[2] << 16U) | ((uint32_t)f->data[3] << 24U));
     m->seq = (uint8_t)((uint32_t)f->data[4]);
     m->flags = (uint8_t)((uint32_t)f->data[5]);
     return ODO_CAN_OK;
@@ -129,9 +137,9 @@ odo_can_result_t odo_can_unpack_ipec_corr(const odo_can_frame_t *f, odo_msg_ipec
         return ODO_CAN_ERR_DLC;
     }
     m->dtheta_a_bam = odo_can_as_s32_((uint32_t)f->data[0] | ((uint32_t)f->data[1] << 8U) |
-                                      ((uint32_t)f->data[2] << 16U) | ((uint32_t)f->data[3] << 24U));
+        ((uint32_t)f->data[2] << 16U) | ((uint32_t)f->data[3] << 24U));
     m->dtheta_b_bam = odo_can_as_s32_((uint32_t)f->data[4] | ((uint32_t)f->data[5] << 8U) |
-                                      ((uint32_t)f->data[6] << 16U) | ((uint32_t)f->data[7] << 24U));
+        ((uint32_t)f->data[6] << 16U) | ((uint32_t)f->data[7] << 24U));
     return ODO_CAN_OK;
 }
 
@@ -146,8 +154,8 @@ odo_can_result_t odo_can_unpack_status(const odo_can_frame_t *f, odo_msg_status_
     if (f->dlc != ODO_CAN_DLC_STATUS) {
         return ODO_CAN_ERR_DLC;
     }
-    m->faults = (uint32_t)((uint32_t)f->data[0] | ((uint32_t)f->data[1] << 8U) | ((uint32_t)f->data[2] << 16U) |
-                           ((uint32_t)f->data[3] << 24U));
+    m->faults = (uint32_t)((uint32_t)f->data[0] | ((uint32_t)f->data[1] << 8U) |
+        ((uint32_t)f->data[2] << 16U) | ((uint32_t)f->data[3] << 24U));
     m->seq = (uint8_t)((uint32_t)f->data[4]);
     m->param_state = (uint8_t)((uint32_t)f->data[5]);
     m->rejected = (uint16_t)((uint32_t)f->data[6] | ((uint32_t)f->data[7] << 8U));
@@ -182,55 +190,85 @@ static const odo_can_signal_info_t sig_pose_xy_a[] = {
     {"Y", 32U, 32U, true},
 };
 static const odo_can_signal_info_t sig_pose_theta_a[] = {
-    {"Theta", 0U, 32U, false}, {"Seq", 32U, 8U, false},         {"Missing", 40U, 1U, false},
-    {"Jump", 41U, 1U, false},  {"Ipec", 42U, 1U, false},        {"IpecGated", 43U, 1U, false},
-    {"Range", 44U, 1U, false}, {"XySaturated", 45U, 1U, false}, {"FlagsReserved", 46U, 2U, false},
+    {"Theta", 0U, 32U, false},
+    {"Seq", 32U, 8U, false},
+    {"Missing", 40U, 1U, false},
+    {"Jump", 41U, 1U, false},
+    {"Ipec", 42U, 1U, false},
+    {"IpecGated", 43U, 1U, false},
+    {"Range", 44U, 1U, false},
+    {"XySaturated", 45U, 1U, false},
+    {"FlagsReserved", 46U, 2U, false},
 };
 static const odo_can_signal_info_t sig_pose_xy_b[] = {
     {"X", 0U, 32U, true},
     {"Y", 32U, 32U, true},
 };
 static const odo_can_signal_info_t sig_pose_theta_b[] = {
-    {"Theta", 0U, 32U, false}, {"Seq", 32U, 8U, false},         {"Missing", 40U, 1U, false},
-    {"Jump", 41U, 1U, false},  {"Ipec", 42U, 1U, false},        {"IpecGated", 43U, 1U, false},
-    {"Range", 44U, 1U, false}, {"XySaturated", 45U, 1U, false}, {"FlagsReserved", 46U, 2U, false},
+    {"Theta", 0U, 32U, false},
+    {"Seq", 32U, 8U, false},
+    {"Missing", 40U, 1U, false},
+    {"Jump", 41U, 1U, false},
+    {"Ipec", 42U, 1U, false},
+    {"IpecGated", 43U, 1U, false},
+    {"Range", 44U, 1U, false},
+    {"XySaturated", 45U, 1U, false},
+    {"FlagsReserved", 46U, 2U, false},
 };
 static const odo_can_signal_info_t sig_ipec_corr[] = {
     {"DThetaA", 0U, 32U, true},
     {"DThetaB", 32U, 32U, true},
 };
 static const odo_can_signal_info_t sig_status[] = {
-    {"ParamsDefaulted", 0U, 1U, false},  {"CounterJumpA", 1U, 1U, false},
-    {"CounterJumpB", 2U, 1U, false},     {"WheelMissingA", 3U, 1U, false},
-    {"WheelMissingB", 4U, 1U, false},    {"SeqGap", 5U, 1U, false},
-    {"SeqDup", 6U, 1U, false},           {"DecoderA", 7U, 1U, false},
-    {"DecoderB", 8U, 1U, false},         {"LinkMissing", 9U, 1U, false},
-    {"LinkStale", 10U, 1U, false},       {"LinkRange", 11U, 1U, false},
-    {"LinkJump", 12U, 1U, false},        {"IpecGated", 13U, 1U, false},
-    {"CanBadDlc", 14U, 1U, false},       {"CanUnknownId", 15U, 1U, false},
-    {"BusError", 16U, 1U, false},        {"TimeBackwards", 17U, 1U, false},
-    {"PoseRange", 18U, 1U, false},       {"PoseXySaturated", 19U, 1U, false},
-    {"FaultsReserved", 20U, 12U, false}, {"Seq", 32U, 8U, false},
-    {"ParamState", 40U, 8U, false},      {"Rejected", 48U, 16U, false},
+    {"ParamsDefaulted", 0U, 1U, false},
+    {"CounterJumpA", 1U, 1U, false},
+    {"CounterJumpB", 2U, 1U, false},
+    {"WheelMissingA", 3U, 1U, false},
+    {"WheelMissingB", 4U, 1U, false},
+    {"SeqGap", 5U, 1U, false},
+    {"SeqDup", 6U, 1U, false},
+    {"DecoderA", 7U, 1U, false},
+    {"DecoderB", 8U, 1U, false},
+    {"LinkMissing", 9U, 1U, false},
+    {"LinkStale", 10U, 1U, false},
+    {"LinkRange", 11U, 1U, false},
+    {"LinkJump", 12U, 1U, false},
+    {"IpecGated", 13U, 1U, false},
+    {"CanBadDlc", 14U, 1U, false},
+    {"CanUnknownId", 15U, 1U, false},
+    {"BusError", 16U, 1U, false},
+    {"TimeBackwards", 17U, 1U, false},
+    {"PoseRange", 18U, 1U, false},
+    {"PoseXySaturated", 19U, 1U, false},
+    {"FaultsReserved", 20U, 12U, false},
+    {"Seq", 32U, 8U, false},
+    {"ParamState", 40U, 8U, false},
+    {"Rejected", 48U, 16U, false},
 };
 
 /* Indexed by odo_can_msg_t; entry 0 (UNKNOWN) is never returned. */
 static const odo_can_msg_info_t msg_table[ODO_CAN_MSG_COUNT + 1U] = {
     [ODO_CAN_MSG_UNKNOWN] = {"UNKNOWN", 0U, 0U, 0U, NULL},
-    [ODO_CAN_MSG_WHEEL_COUNTS_A] = {"WHEEL_COUNTS_A", ODO_CAN_ID_WHEEL_COUNTS_A, ODO_CAN_DLC_WHEEL_COUNTS, 4U,
-                                    sig_wheel_counts_a},
-    [ODO_CAN_MSG_WHEEL_COUNTS_B] = {"WHEEL_COUNTS_B", ODO_CAN_ID_WHEEL_COUNTS_B, ODO_CAN_DLC_WHEEL_COUNTS, 4U,
-                                    sig_wheel_counts_b},
-    [ODO_CAN_MSG_LINK_ROTARY] = {"LINK_ROTARY", ODO_CAN_ID_LINK_ROTARY, ODO_CAN_DLC_LINK_ROTARY, 4U, sig_link_rotary},
-    [ODO_CAN_MSG_LINK_LINEAR] = {"LINK_LINEAR", ODO_CAN_ID_LINK_LINEAR, ODO_CAN_DLC_LINK_LINEAR, 3U, sig_link_linear},
-    [ODO_CAN_MSG_POSE_XY_A] = {"POSE_XY_A", ODO_CAN_ID_POSE_XY_A, ODO_CAN_DLC_POSE_XY, 2U, sig_pose_xy_a},
-    [ODO_CAN_MSG_POSE_THETA_A] = {"POSE_THETA_A", ODO_CAN_ID_POSE_THETA_A, ODO_CAN_DLC_POSE_THETA, 9U,
-                                  sig_pose_theta_a},
-    [ODO_CAN_MSG_POSE_XY_B] = {"POSE_XY_B", ODO_CAN_ID_POSE_XY_B, ODO_CAN_DLC_POSE_XY, 2U, sig_pose_xy_b},
-    [ODO_CAN_MSG_POSE_THETA_B] = {"POSE_THETA_B", ODO_CAN_ID_POSE_THETA_B, ODO_CAN_DLC_POSE_THETA, 9U,
-                                  sig_pose_theta_b},
-    [ODO_CAN_MSG_IPEC_CORR] = {"IPEC_CORR", ODO_CAN_ID_IPEC_CORR, ODO_CAN_DLC_IPEC_CORR, 2U, sig_ipec_corr},
-    [ODO_CAN_MSG_STATUS] = {"STATUS", ODO_CAN_ID_STATUS, ODO_CAN_DLC_STATUS, 24U, sig_status},
+    [ODO_CAN_MSG_WHEEL_COUNTS_A] = {"WHEEL_COUNTS_A", ODO_CAN_ID_WHEEL_COUNTS_A,
+        ODO_CAN_DLC_WHEEL_COUNTS, 4U, sig_wheel_counts_a},
+    [ODO_CAN_MSG_WHEEL_COUNTS_B] = {"WHEEL_COUNTS_B", ODO_CAN_ID_WHEEL_COUNTS_B,
+        ODO_CAN_DLC_WHEEL_COUNTS, 4U, sig_wheel_counts_b},
+    [ODO_CAN_MSG_LINK_ROTARY] = {"LINK_ROTARY", ODO_CAN_ID_LINK_ROTARY,
+        ODO_CAN_DLC_LINK_ROTARY, 4U, sig_link_rotary},
+    [ODO_CAN_MSG_LINK_LINEAR] = {"LINK_LINEAR", ODO_CAN_ID_LINK_LINEAR,
+        ODO_CAN_DLC_LINK_LINEAR, 3U, sig_link_linear},
+    [ODO_CAN_MSG_POSE_XY_A] = {"POSE_XY_A", ODO_CAN_ID_POSE_XY_A,
+        ODO_CAN_DLC_POSE_XY, 2U, sig_pose_xy_a},
+    [ODO_CAN_MSG_POSE_THETA_A] = {"POSE_THETA_A", ODO_CAN_ID_POSE_THETA_A,
+        ODO_CAN_DLC_POSE_THETA, 9U, sig_pose_theta_a},
+    [ODO_CAN_MSG_POSE_XY_B] = {"POSE_XY_B", ODO_CAN_ID_POSE_XY_B,
+        ODO_CAN_DLC_POSE_XY, 2U, sig_pose_xy_b},
+    [ODO_CAN_MSG_POSE_THETA_B] = {"POSE_THETA_B", ODO_CAN_ID_POSE_THETA_B,
+        ODO_CAN_DLC_POSE_THETA, 9U, sig_pose_theta_b},
+    [ODO_CAN_MSG_IPEC_CORR] = {"IPEC_CORR", ODO_CAN_ID_IPEC_CORR,
+        ODO_CAN_DLC_IPEC_CORR, 2U, sig_ipec_corr},
+    [ODO_CAN_MSG_STATUS] = {"STATUS", ODO_CAN_ID_STATUS,
+        ODO_CAN_DLC_STATUS, 24U, sig_status},
 };
 
 odo_can_msg_t odo_can_classify(const odo_can_frame_t *f)
@@ -257,15 +295,22 @@ uint8_t odo_can_expected_dlc(odo_can_msg_t m)
 {
     switch (m) {
     case ODO_CAN_MSG_WHEEL_COUNTS_A:
-    case ODO_CAN_MSG_WHEEL_COUNTS_B: return ODO_CAN_DLC_WHEEL_COUNTS;
-    case ODO_CAN_MSG_LINK_ROTARY: return ODO_CAN_DLC_LINK_ROTARY;
-    case ODO_CAN_MSG_LINK_LINEAR: return ODO_CAN_DLC_LINK_LINEAR;
+    case ODO_CAN_MSG_WHEEL_COUNTS_B:
+        return ODO_CAN_DLC_WHEEL_COUNTS;
+    case ODO_CAN_MSG_LINK_ROTARY:
+        return ODO_CAN_DLC_LINK_ROTARY;
+    case ODO_CAN_MSG_LINK_LINEAR:
+        return ODO_CAN_DLC_LINK_LINEAR;
     case ODO_CAN_MSG_POSE_XY_A:
-    case ODO_CAN_MSG_POSE_XY_B: return ODO_CAN_DLC_POSE_XY;
+    case ODO_CAN_MSG_POSE_XY_B:
+        return ODO_CAN_DLC_POSE_XY;
     case ODO_CAN_MSG_POSE_THETA_A:
-    case ODO_CAN_MSG_POSE_THETA_B: return ODO_CAN_DLC_POSE_THETA;
-    case ODO_CAN_MSG_IPEC_CORR: return ODO_CAN_DLC_IPEC_CORR;
-    case ODO_CAN_MSG_STATUS: return ODO_CAN_DLC_STATUS;
+    case ODO_CAN_MSG_POSE_THETA_B:
+        return ODO_CAN_DLC_POSE_THETA;
+    case ODO_CAN_MSG_IPEC_CORR:
+        return ODO_CAN_DLC_IPEC_CORR;
+    case ODO_CAN_MSG_STATUS:
+        return ODO_CAN_DLC_STATUS;
     case ODO_CAN_MSG_UNKNOWN:
     default: return 0U;
     }
@@ -325,10 +370,11 @@ bool odo_can_pack_signals(odo_can_msg_t m, const int64_t *raw, odo_can_frame_t *
         odo_msg_pose_theta_t s;
         s.theta_bam = (uint32_t)(((uint32_t)(uint64_t)raw[0] & 0xFFFFFFFFU));
         s.seq = (uint8_t)(((uint32_t)(uint64_t)raw[1] & 0xFFU));
-        s.flags = (uint8_t)(((uint32_t)(uint64_t)raw[2] & 0x1U) | (((uint32_t)(uint64_t)raw[3] & 0x1U) << 1U) |
-                            (((uint32_t)(uint64_t)raw[4] & 0x1U) << 2U) | (((uint32_t)(uint64_t)raw[5] & 0x1U) << 3U) |
-                            (((uint32_t)(uint64_t)raw[6] & 0x1U) << 4U) | (((uint32_t)(uint64_t)raw[7] & 0x1U) << 5U) |
-                            (((uint32_t)(uint64_t)raw[8] & 0x3U) << 6U));
+        s.flags = (uint8_t)(((uint32_t)(uint64_t)raw[2] & 0x1U) | (((uint32_t)(uint64_t)raw[3] &
+            0x1U) << 1U) | (((uint32_t)(uint64_t)raw[4] & 0x1U) << 2U) |
+            (((uint32_t)(uint64_t)raw[5] & 0x1U) << 3U) | (((uint32_t)(uint64_t)raw[6] & 0x1U) <<
+            4U) | (((uint32_t)(uint64_t)raw[7] & 0x1U) << 5U) | (((uint32_t)(uint64_t)raw[8] & 0x3U)
+            << 6U));
         odo_can_pack_pose_theta((uint8_t)ODO_TRUCK_A, &s, f);
         return true;
     }
@@ -343,10 +389,11 @@ bool odo_can_pack_signals(odo_can_msg_t m, const int64_t *raw, odo_can_frame_t *
         odo_msg_pose_theta_t s;
         s.theta_bam = (uint32_t)(((uint32_t)(uint64_t)raw[0] & 0xFFFFFFFFU));
         s.seq = (uint8_t)(((uint32_t)(uint64_t)raw[1] & 0xFFU));
-        s.flags = (uint8_t)(((uint32_t)(uint64_t)raw[2] & 0x1U) | (((uint32_t)(uint64_t)raw[3] & 0x1U) << 1U) |
-                            (((uint32_t)(uint64_t)raw[4] & 0x1U) << 2U) | (((uint32_t)(uint64_t)raw[5] & 0x1U) << 3U) |
-                            (((uint32_t)(uint64_t)raw[6] & 0x1U) << 4U) | (((uint32_t)(uint64_t)raw[7] & 0x1U) << 5U) |
-                            (((uint32_t)(uint64_t)raw[8] & 0x3U) << 6U));
+        s.flags = (uint8_t)(((uint32_t)(uint64_t)raw[2] & 0x1U) | (((uint32_t)(uint64_t)raw[3] &
+            0x1U) << 1U) | (((uint32_t)(uint64_t)raw[4] & 0x1U) << 2U) |
+            (((uint32_t)(uint64_t)raw[5] & 0x1U) << 3U) | (((uint32_t)(uint64_t)raw[6] & 0x1U) <<
+            4U) | (((uint32_t)(uint64_t)raw[7] & 0x1U) << 5U) | (((uint32_t)(uint64_t)raw[8] & 0x3U)
+            << 6U));
         odo_can_pack_pose_theta((uint8_t)ODO_TRUCK_B, &s, f);
         return true;
     }
@@ -359,18 +406,19 @@ bool odo_can_pack_signals(odo_can_msg_t m, const int64_t *raw, odo_can_frame_t *
     }
     case ODO_CAN_MSG_STATUS: {
         odo_msg_status_t s;
-        s.faults =
-            (uint32_t)(((uint32_t)(uint64_t)raw[0] & 0x1U) | (((uint32_t)(uint64_t)raw[1] & 0x1U) << 1U) |
-                       (((uint32_t)(uint64_t)raw[2] & 0x1U) << 2U) | (((uint32_t)(uint64_t)raw[3] & 0x1U) << 3U) |
-                       (((uint32_t)(uint64_t)raw[4] & 0x1U) << 4U) | (((uint32_t)(uint64_t)raw[5] & 0x1U) << 5U) |
-                       (((uint32_t)(uint64_t)raw[6] & 0x1U) << 6U) | (((uint32_t)(uint64_t)raw[7] & 0x1U) << 7U) |
-                       (((uint32_t)(uint64_t)raw[8] & 0x1U) << 8U) | (((uint32_t)(uint64_t)raw[9] & 0x1U) << 9U) |
-                       (((uint32_t)(uint64_t)raw[10] & 0x1U) << 10U) | (((uint32_t)(uint64_t)raw[11] & 0x1U) << 11U) |
-                       (((uint32_t)(uint64_t)raw[12] & 0x1U) << 12U) | (((uint32_t)(uint64_t)raw[13] & 0x1U) << 13U) |
-                       (((uint32_t)(uint64_t)raw[14] & 0x1U) << 14U) | (((uint32_t)(uint64_t)raw[15] & 0x1U) << 15U) |
-                       (((uint32_t)(uint64_t)raw[16] & 0x1U) << 16U) | (((uint32_t)(uint64_t)raw[17] & 0x1U) << 17U) |
-                       (((uint32_t)(uint64_t)raw[18] & 0x1U) << 18U) | (((uint32_t)(uint64_t)raw[19] & 0x1U) << 19U) |
-                       (((uint32_t)(uint64_t)raw[20] & 0xFFFU) << 20U));
+        s.faults = (uint32_t)(((uint32_t)(uint64_t)raw[0] & 0x1U) | (((uint32_t)(uint64_t)raw[1]
+            & 0x1U) << 1U) | (((uint32_t)(uint64_t)raw[2] & 0x1U) << 2U) |
+            (((uint32_t)(uint64_t)raw[3] & 0x1U) << 3U) | (((uint32_t)(uint64_t)raw[4] & 0x1U) <<
+            4U) | (((uint32_t)(uint64_t)raw[5] & 0x1U) << 5U) | (((uint32_t)(uint64_t)raw[6] & 0x1U)
+            << 6U) | (((uint32_t)(uint64_t)raw[7] & 0x1U) << 7U) | (((uint32_t)(uint64_t)raw[8] &
+            0x1U) << 8U) | (((uint32_t)(uint64_t)raw[9] & 0x1U) << 9U) |
+            (((uint32_t)(uint64_t)raw[10] & 0x1U) << 10U) | (((uint32_t)(uint64_t)raw[11] & 0x1U) <<
+            11U) | (((uint32_t)(uint64_t)raw[12] & 0x1U) << 12U) | (((uint32_t)(uint64_t)raw[13] &
+            0x1U) << 13U) | (((uint32_t)(uint64_t)raw[14] & 0x1U) << 14U) |
+            (((uint32_t)(uint64_t)raw[15] & 0x1U) << 15U) | (((uint32_t)(uint64_t)raw[16] & 0x1U) <<
+            16U) | (((uint32_t)(uint64_t)raw[17] & 0x1U) << 17U) | (((uint32_t)(uint64_t)raw[18] &
+            0x1U) << 18U) | (((uint32_t)(uint64_t)raw[19] & 0x1U) << 19U) |
+            (((uint32_t)(uint64_t)raw[20] & 0xFFFU) << 20U));
         s.seq = (uint8_t)(((uint32_t)(uint64_t)raw[21] & 0xFFU));
         s.param_state = (uint8_t)(((uint32_t)(uint64_t)raw[22] & 0xFFU));
         s.rejected = (uint16_t)(((uint32_t)(uint64_t)raw[23] & 0xFFFFU));
@@ -382,7 +430,8 @@ bool odo_can_pack_signals(odo_can_msg_t m, const int64_t *raw, odo_can_frame_t *
     }
 }
 
-odo_can_result_t odo_can_unpack_signals(odo_can_msg_t m, const odo_can_frame_t *f, int64_t *raw)
+odo_can_result_t odo_can_unpack_signals(odo_can_msg_t m, const odo_can_frame_t *f,
+                                        int64_t *raw)
 {
     odo_can_result_t r = ODO_CAN_ERR_ID;
     switch (m) {

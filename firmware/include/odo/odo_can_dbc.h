@@ -23,7 +23,7 @@
 ///       LinkMissing 9|1, LinkStale 10|1, LinkRange 11|1, LinkJump 12|1, IpecGated 13|1, CanBadDlc
 ///       14|1, CanUnknownId 15|1, BusError 16|1, TimeBackwards 17|1, PoseRange 18|1,
 ///       PoseXySaturated 19|1, FaultsReserved 20|12, Seq 32|8, ParamState 40|8, Rejected 48|16
-// clang-format off: generated code, laid out by cangen.py
+// clang-format off
 #ifndef ODO_CAN_DBC_H
 #define ODO_CAN_DBC_H
 
@@ -34,50 +34,50 @@
 #include <string.h>
 
 /// Identifiers (11-bit, standard frames).
-#define ODO_CAN_ID_WHEEL_COUNTS_A 0x110U
-#define ODO_CAN_ID_WHEEL_COUNTS_B 0x111U
-#define ODO_CAN_ID_LINK_ROTARY    0x120U
-#define ODO_CAN_ID_LINK_LINEAR    0x121U
-#define ODO_CAN_ID_POSE_XY_A      0x180U
-#define ODO_CAN_ID_POSE_THETA_A   0x181U
-#define ODO_CAN_ID_POSE_XY_B      0x182U
-#define ODO_CAN_ID_POSE_THETA_B   0x183U
-#define ODO_CAN_ID_IPEC_CORR      0x190U
-#define ODO_CAN_ID_STATUS         0x1A0U
+#define ODO_CAN_ID_WHEEL_COUNTS_A  0x110U
+#define ODO_CAN_ID_WHEEL_COUNTS_B  0x111U
+#define ODO_CAN_ID_LINK_ROTARY     0x120U
+#define ODO_CAN_ID_LINK_LINEAR     0x121U
+#define ODO_CAN_ID_POSE_XY_A       0x180U
+#define ODO_CAN_ID_POSE_THETA_A    0x181U
+#define ODO_CAN_ID_POSE_XY_B       0x182U
+#define ODO_CAN_ID_POSE_THETA_B    0x183U
+#define ODO_CAN_ID_IPEC_CORR       0x190U
+#define ODO_CAN_ID_STATUS          0x1A0U
 
 /// Data length codes: every frame of a message (family) has exactly this length.
-#define ODO_CAN_DLC_WHEEL_COUNTS 8U
-#define ODO_CAN_DLC_LINK_ROTARY  6U
-#define ODO_CAN_DLC_LINK_LINEAR  6U
-#define ODO_CAN_DLC_POSE_XY      8U
-#define ODO_CAN_DLC_POSE_THETA   6U
-#define ODO_CAN_DLC_IPEC_CORR    8U
-#define ODO_CAN_DLC_STATUS       8U
+#define ODO_CAN_DLC_WHEEL_COUNTS  8U
+#define ODO_CAN_DLC_LINK_ROTARY   6U
+#define ODO_CAN_DLC_LINK_LINEAR   6U
+#define ODO_CAN_DLC_POSE_XY       8U
+#define ODO_CAN_DLC_POSE_THETA    6U
+#define ODO_CAN_DLC_IPEC_CORR     8U
+#define ODO_CAN_DLC_STATUS        8U
 
 /// Period of every message, from the DBC's GenMsgCycleTime.
 #define ODO_CAN_CYCLE_TIME_US 40000UL
 
 /// Width in bits of each single-signal field: the raw range of its signal.
-#define ODO_CAN_BITS_WHEEL_COUNTS_LEFT_COUNT  24U
+#define ODO_CAN_BITS_WHEEL_COUNTS_LEFT_COUNT 24U
 #define ODO_CAN_BITS_WHEEL_COUNTS_RIGHT_COUNT 24U
-#define ODO_CAN_BITS_WHEEL_COUNTS_SEQ         8U
-#define ODO_CAN_BITS_WHEEL_COUNTS_STATUS      8U
-#define ODO_CAN_BITS_LINK_ROTARY_ALPHA_BAM16  16U
-#define ODO_CAN_BITS_LINK_ROTARY_BETA_BAM16   16U
-#define ODO_CAN_BITS_LINK_ROTARY_SEQ          8U
-#define ODO_CAN_BITS_LINK_ROTARY_STATUS       8U
-#define ODO_CAN_BITS_LINK_LINEAR_LENGTH_UM    32U
-#define ODO_CAN_BITS_LINK_LINEAR_SEQ          8U
-#define ODO_CAN_BITS_LINK_LINEAR_STATUS       8U
-#define ODO_CAN_BITS_POSE_XY_X_10UM           32U
-#define ODO_CAN_BITS_POSE_XY_Y_10UM           32U
-#define ODO_CAN_BITS_POSE_THETA_THETA_BAM     32U
-#define ODO_CAN_BITS_POSE_THETA_SEQ           8U
-#define ODO_CAN_BITS_IPEC_CORR_DTHETA_A_BAM   32U
-#define ODO_CAN_BITS_IPEC_CORR_DTHETA_B_BAM   32U
-#define ODO_CAN_BITS_STATUS_SEQ               8U
-#define ODO_CAN_BITS_STATUS_PARAM_STATE       8U
-#define ODO_CAN_BITS_STATUS_REJECTED          16U
+#define ODO_CAN_BITS_WHEEL_COUNTS_SEQ 8U
+#define ODO_CAN_BITS_WHEEL_COUNTS_STATUS 8U
+#define ODO_CAN_BITS_LINK_ROTARY_ALPHA_BAM16 16U
+#define ODO_CAN_BITS_LINK_ROTARY_BETA_BAM16 16U
+#define ODO_CAN_BITS_LINK_ROTARY_SEQ 8U
+#define ODO_CAN_BITS_LINK_ROTARY_STATUS 8U
+#define ODO_CAN_BITS_LINK_LINEAR_LENGTH_UM 32U
+#define ODO_CAN_BITS_LINK_LINEAR_SEQ 8U
+#define ODO_CAN_BITS_LINK_LINEAR_STATUS 8U
+#define ODO_CAN_BITS_POSE_XY_X_10UM 32U
+#define ODO_CAN_BITS_POSE_XY_Y_10UM 32U
+#define ODO_CAN_BITS_POSE_THETA_THETA_BAM 32U
+#define ODO_CAN_BITS_POSE_THETA_SEQ 8U
+#define ODO_CAN_BITS_IPEC_CORR_DTHETA_A_BAM 32U
+#define ODO_CAN_BITS_IPEC_CORR_DTHETA_B_BAM 32U
+#define ODO_CAN_BITS_STATUS_SEQ 8U
+#define ODO_CAN_BITS_STATUS_PARAM_STATE 8U
+#define ODO_CAN_BITS_STATUS_REJECTED 16U
 
 /// Which message a frame is. ODO_CAN_MSG_UNKNOWN is 0; the known messages are 1..ODO_CAN_MSG_COUNT
 /// in identifier order, so the value can index a table of ODO_CAN_MSG_COUNT + 1 entries.
@@ -141,11 +141,13 @@ typedef struct {
 /// Pack WHEEL_COUNTS_A / WHEEL_COUNTS_B: truck ODO_TRUCK_A -> ODO_CAN_ID_WHEEL_COUNTS_A, any other
 /// value -> ODO_CAN_ID_WHEEL_COUNTS_B. Writes id, dlc, flags = 0 and all 8 data bytes (zero beyond
 /// the DLC and in bits no signal covers). Constant time.
-static inline void odo_can_pack_wheel_counts(uint8_t truck, const odo_msg_wheel_counts_t *m, odo_can_frame_t *f)
+static inline void odo_can_pack_wheel_counts(uint8_t truck, const odo_msg_wheel_counts_t *m,
+                                             odo_can_frame_t *f)
 {
-    const uint32_t w0 = ((uint32_t)m->left_count & 0xFFFFFFU) | (((uint32_t)m->right_count & 0xFFFFFFU) << 24U);
-    const uint32_t w1 =
-        (((uint32_t)m->right_count & 0xFFFFFFU) >> 8U) | ((uint32_t)m->seq << 16U) | ((uint32_t)m->status << 24U);
+    const uint32_t w0 = ((uint32_t)m->left_count & 0xFFFFFFU) | (((uint32_t)m->right_count &
+        0xFFFFFFU) << 24U);
+    const uint32_t w1 = (((uint32_t)m->right_count & 0xFFFFFFU) >> 8U) | ((uint32_t)m->seq <<
+        16U) | ((uint32_t)m->status << 24U);
     f->id = truck == ODO_TRUCK_A ? ODO_CAN_ID_WHEEL_COUNTS_A : ODO_CAN_ID_WHEEL_COUNTS_B;
     f->dlc = ODO_CAN_DLC_WHEEL_COUNTS;
     f->flags = 0U;
@@ -156,7 +158,8 @@ static inline void odo_can_pack_wheel_counts(uint8_t truck, const odo_msg_wheel_
 /// Unpack WHEEL_COUNTS_A / WHEEL_COUNTS_B; *truck receives ODO_TRUCK_A or ODO_TRUCK_B. Returns
 /// ODO_CAN_ERR_FLAGS, ODO_CAN_ERR_ID or ODO_CAN_ERR_DLC (checked in that order; *truck and *m
 /// untouched) or ODO_CAN_OK. Reads only the DLC's bytes. Constant time.
-odo_can_result_t odo_can_unpack_wheel_counts(const odo_can_frame_t *f, uint8_t *truck, odo_msg_wheel_counts_t *m);
+odo_can_result_t odo_can_unpack_wheel_counts(const odo_can_frame_t *f, uint8_t *truck,
+                                             odo_msg_wheel_counts_t *m);
 
 /// LINK_ROTARY: Linkage rotary encoders, one sample: alpha (truck A relative to the link, or the
 /// trailer joint angle) and beta (truck B relative to the link, clapper only).
@@ -240,7 +243,8 @@ typedef struct {
 /// Pack POSE_XY_A / POSE_XY_B: truck ODO_TRUCK_A -> ODO_CAN_ID_POSE_XY_A, any other value ->
 /// ODO_CAN_ID_POSE_XY_B. Writes id, dlc, flags = 0 and all 8 data bytes (zero beyond the DLC and in
 /// bits no signal covers). Constant time.
-static inline void odo_can_pack_pose_xy(uint8_t truck, const odo_msg_pose_xy_t *m, odo_can_frame_t *f)
+static inline void odo_can_pack_pose_xy(uint8_t truck, const odo_msg_pose_xy_t *m,
+                                        odo_can_frame_t *f)
 {
     const uint32_t w0 = (uint32_t)m->x_10um;
     const uint32_t w1 = (uint32_t)m->y_10um;
@@ -254,7 +258,8 @@ static inline void odo_can_pack_pose_xy(uint8_t truck, const odo_msg_pose_xy_t *
 /// Unpack POSE_XY_A / POSE_XY_B; *truck receives ODO_TRUCK_A or ODO_TRUCK_B. Returns
 /// ODO_CAN_ERR_FLAGS, ODO_CAN_ERR_ID or ODO_CAN_ERR_DLC (checked in that order; *truck and *m
 /// untouched) or ODO_CAN_OK. Reads only the DLC's bytes. Constant time.
-odo_can_result_t odo_can_unpack_pose_xy(const odo_can_frame_t *f, uint8_t *truck, odo_msg_pose_xy_t *m);
+odo_can_result_t odo_can_unpack_pose_xy(const odo_can_frame_t *f, uint8_t *truck,
+                                        odo_msg_pose_xy_t *m);
 
 /// POSE_THETA_A / POSE_THETA_B: Heading of truck A, the sequence number of the tick and pose flags.
 /// Sent after POSE_XY_A every tick.
@@ -273,7 +278,8 @@ typedef struct {
 /// Pack POSE_THETA_A / POSE_THETA_B: truck ODO_TRUCK_A -> ODO_CAN_ID_POSE_THETA_A, any other value
 /// -> ODO_CAN_ID_POSE_THETA_B. Writes id, dlc, flags = 0 and all 8 data bytes (zero beyond the DLC
 /// and in bits no signal covers). Constant time.
-static inline void odo_can_pack_pose_theta(uint8_t truck, const odo_msg_pose_theta_t *m, odo_can_frame_t *f)
+static inline void odo_can_pack_pose_theta(uint8_t truck, const odo_msg_pose_theta_t *m,
+                                           odo_can_frame_t *f)
 {
     const uint32_t w0 = (uint32_t)m->theta_bam;
     const uint32_t w1 = (uint32_t)m->seq | ((uint32_t)m->flags << 8U);
@@ -287,7 +293,8 @@ static inline void odo_can_pack_pose_theta(uint8_t truck, const odo_msg_pose_the
 /// Unpack POSE_THETA_A / POSE_THETA_B; *truck receives ODO_TRUCK_A or ODO_TRUCK_B. Returns
 /// ODO_CAN_ERR_FLAGS, ODO_CAN_ERR_ID or ODO_CAN_ERR_DLC (checked in that order; *truck and *m
 /// untouched) or ODO_CAN_OK. Reads only the DLC's bytes. Constant time.
-odo_can_result_t odo_can_unpack_pose_theta(const odo_can_frame_t *f, uint8_t *truck, odo_msg_pose_theta_t *m);
+odo_can_result_t odo_can_unpack_pose_theta(const odo_can_frame_t *f, uint8_t *truck,
+                                           odo_msg_pose_theta_t *m);
 
 /// IPEC_CORR: IPEC heading corrections applied in this tick (002 Eqs. 9-16), one per truck; 0 when
 /// IPEC is off or gated.
@@ -340,7 +347,8 @@ typedef struct {
 static inline void odo_can_pack_status(const odo_msg_status_t *m, odo_can_frame_t *f)
 {
     const uint32_t w0 = (uint32_t)m->faults;
-    const uint32_t w1 = (uint32_t)m->seq | ((uint32_t)m->param_state << 8U) | ((uint32_t)m->rejected << 16U);
+    const uint32_t w1 = (uint32_t)m->seq | ((uint32_t)m->param_state << 8U) |
+        ((uint32_t)m->rejected << 16U);
     f->id = ODO_CAN_ID_STATUS;
     f->dlc = ODO_CAN_DLC_STATUS;
     f->flags = 0U;
