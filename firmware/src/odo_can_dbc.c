@@ -291,29 +291,24 @@ odo_can_msg_t odo_can_classify(const odo_can_frame_t *f)
     }
 }
 
+/* Indexed by odo_can_msg_t: a byte table rather than a switch (several DLCs are equal). */
+static const uint8_t dlc_table[ODO_CAN_MSG_COUNT + 1U] = {
+    [ODO_CAN_MSG_UNKNOWN] = 0U,
+    [ODO_CAN_MSG_WHEEL_COUNTS_A] = ODO_CAN_DLC_WHEEL_COUNTS,
+    [ODO_CAN_MSG_WHEEL_COUNTS_B] = ODO_CAN_DLC_WHEEL_COUNTS,
+    [ODO_CAN_MSG_LINK_ROTARY] = ODO_CAN_DLC_LINK_ROTARY,
+    [ODO_CAN_MSG_LINK_LINEAR] = ODO_CAN_DLC_LINK_LINEAR,
+    [ODO_CAN_MSG_POSE_XY_A] = ODO_CAN_DLC_POSE_XY,
+    [ODO_CAN_MSG_POSE_THETA_A] = ODO_CAN_DLC_POSE_THETA,
+    [ODO_CAN_MSG_POSE_XY_B] = ODO_CAN_DLC_POSE_XY,
+    [ODO_CAN_MSG_POSE_THETA_B] = ODO_CAN_DLC_POSE_THETA,
+    [ODO_CAN_MSG_IPEC_CORR] = ODO_CAN_DLC_IPEC_CORR,
+    [ODO_CAN_MSG_STATUS] = ODO_CAN_DLC_STATUS,
+};
+
 uint8_t odo_can_expected_dlc(odo_can_msg_t m)
 {
-    switch (m) {
-    case ODO_CAN_MSG_WHEEL_COUNTS_A:
-    case ODO_CAN_MSG_WHEEL_COUNTS_B:
-        return ODO_CAN_DLC_WHEEL_COUNTS;
-    case ODO_CAN_MSG_LINK_ROTARY:
-        return ODO_CAN_DLC_LINK_ROTARY;
-    case ODO_CAN_MSG_LINK_LINEAR:
-        return ODO_CAN_DLC_LINK_LINEAR;
-    case ODO_CAN_MSG_POSE_XY_A:
-    case ODO_CAN_MSG_POSE_XY_B:
-        return ODO_CAN_DLC_POSE_XY;
-    case ODO_CAN_MSG_POSE_THETA_A:
-    case ODO_CAN_MSG_POSE_THETA_B:
-        return ODO_CAN_DLC_POSE_THETA;
-    case ODO_CAN_MSG_IPEC_CORR:
-        return ODO_CAN_DLC_IPEC_CORR;
-    case ODO_CAN_MSG_STATUS:
-        return ODO_CAN_DLC_STATUS;
-    case ODO_CAN_MSG_UNKNOWN:
-    default: return 0U;
-    }
+    return (unsigned)m <= ODO_CAN_MSG_COUNT ? dlc_table[m] : 0U;
 }
 
 const odo_can_msg_info_t *odo_can_msg_info(odo_can_msg_t m)

@@ -1,12 +1,13 @@
 /// Sine, cosine and two-argument arctangent on binary angles (odo_fx.h), integer only.
 ///
 /// Method
-///   sin/cos  The top three BAM bits pick an octant; the 29-bit remainder (mirrored in odd
-///            octants) becomes x in [0, pi/4] in Q32. sin x and cos x are the Taylor series
-///            (Abramowitz & Stegun 4.3.65, 4.3.66) to x^11 and x^12 in Horner form on x^2, with
-///            the coefficients 1/k! as Q32 constants, so each step is one 32x32 -> 64 multiply
-///            (UMULL) and a subtraction; the octant then picks which of the two answers and its
-///            sign. Both polynomials share x^2, so odo_sincos_q30 costs one fold for the pair.
+///   sin/cos  The top three BAM bits pick an octant; the 29-bit remainder r (mirrored in odd
+///            octants) is x = r pi/2^31 in [0, pi/4]. Its top 5 bits pick node i of
+///            odo_sin_table_q31 (sin and cos of i pi/128, Q31), the rest is d < pi/128 rad in Q32,
+///            and the angle-sum identities give sin x = S_i cos d + C_i sin d and
+///            cos x = C_i cos d - S_i sin d with 1 - cos d = d^2/2 - d^4/24 and sin d = d - d^3/6
+///            (A&S 4.3.65, 4.3.66 truncated), each product one UMULL; the octant then picks which
+///            of the two answers and its sign. The body is odo_sincos_q30_inline (odo_fx.h).
 ///   atan2    The magnitudes fold the vector into the first octant, 0 <= n <= d, scaled to
 ///            d <= 2^30 with the ratio kept. One 32-bit division (odo_frac_q32: two UDIVs, no
 ///            64-bit division) gives t = n/d in Q32, or u = (d-n)/(d+n) when t > tan(pi/8), so
@@ -14,24 +15,27 @@
 ///            sees |t| <= tan(pi/8) = 0.4142. Radians become BAM through 2^32/pi, and the octant
 ///            is unfolded exactly (pi/4 is 2^29 BAM).
 ///
-/// Error budget (absolute, on the real value; Q32 LSB = 2^-32 = 2.33e-10). Bracketed: the maxima
-/// that tests/unit/test_trig.c measures over 2^20 random inputs per function plus the edge sets.
-///   sin/cos  series truncation   x^13/13! resp. x^14/14! at x = pi/4        < 7.0e-12
-///            x rounded to Q32    1 LSB (constant and rounding), slope <= 1    2.3e-10
-///            Horner, truncating  < 1 LSB per step, damped by x^2 <= 0.62      < 6.1e-10
-///            last two products   rounded, 0.5 LSB each                        2.3e-10
-///            output to Q30       0.5 Q30 LSB                                  4.7e-10
-///            bound                                                            < 1.6e-9
+/// Error budget (absolute, on the real value; Q31 LSB = 4.66e-10, Q32 LSB = 2.33e-10). Bracketed:
+/// the maxima that odo-bench (`sincos_max_abs_err`, `atan2_max_abs_err_rad`) and
+/// tests/unit/test_trig.c measure over 10^6 random inputs plus the edge sets.
+///   sin/cos  series truncation   d^4/720 and d^5/120 at d = pi/128              < 8e-11
+///            table entries       0.5 Q31 LSB each, times |cos d| + |sin d|      2.4e-10
+///            d rounded to Q32    0.5 LSB, slope <= 1                           1.2e-10
+///            1 - cos d, sin d    two truncating products each, 1 Q32 LSB each  < 9.4e-10
+///            the two products    truncated (1 Q31 LSB) and rounded (0.5)       7.0e-10
+///            output to Q30       0.5 Q30 LSB                                    4.7e-10
+///            bound                                                             < 2.5e-9  [1.7e-9]
 ///   atan2    series truncation   u^23/23 at u = 0.4143                        < 7e-11
 ///            operands rounded    0.5 each with d >= 2^29: angle moves         < 1.4e-9
 ///            ratio to Q32        0.5 LSB, slope <= 1                          1.2e-10
 ///            Horner, truncating  < 1 LSB per step damped by u^2 <= 0.172      < 3.3e-10
 ///            radians to BAM      half a BAM plus the constant                 8.0e-10
-///            bound                                                            < 2.8e-9
+///            bound                                                            < 2.8e-9  [1.8e-9]
 ///
-/// Cost on a Cortex-M4 (arm-none-eabi-gcc -O2, counted by `make bench-target`): odo_sincos_q30
-/// about 75 instructions (13 multiplies), odo_sin_q30/odo_cos_q30 about 45, odo_atan2_bam about
-/// 150 (two UDIVs, 12 multiplies). No tables, no state, no library calls, reentrant.
+/// Cost on a Cortex-M4 (arm-none-eabi-gcc -O2, `odo-bench-target --profile`): odo_sincos_q30
+/// about 58 instructions for the pair, odo_sin_q30/odo_cos_q30 the same plus the call;
+/// odo_atan2_bam about 140 plus about 55 in odo_frac_q32 (two UDIVs). One 260-byte table, no
+/// state, no library calls, reentrant.
 
 #include "odo/odo_fx.h"
 

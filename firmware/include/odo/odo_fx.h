@@ -67,7 +67,7 @@ uint32_t odo_frac_q32(uint32_t n, uint32_t d);
 int64_t odo_shr_round_s64(int64_t v, unsigned shift);
 
 /// sin and cos of a binary angle, Q30. Constant time: octant fold, a 65-entry table and a short
-/// series on the remainder (Cortex-M4: about 50 instructions, one or both).
+/// series on the remainder (Cortex-M4: about 58 instructions, one or both).
 int32_t odo_sin_q30(uint32_t angle_bam);
 int32_t odo_cos_q30(uint32_t angle_bam);
 void odo_sincos_q30(uint32_t angle_bam, int32_t *sin_q30, int32_t *cos_q30);
@@ -75,7 +75,7 @@ void odo_sincos_q30(uint32_t angle_bam, int32_t *sin_q30, int32_t *cos_q30);
 /// Angle of the vector (x, y) as a BAM in [0, 2^32): atan2(y, x) mapped so that +x is 0 and +y is
 /// ODO_BAM_QUARTER. Any int64 inputs are valid, INT64_MIN included; (0, 0) returns 0. Constant time
 /// apart from odo_frac_q32's corrections: two 32/32 divisions, no 64-bit division (Cortex-M4:
-/// about 150 instructions).
+/// about 200 instructions with odo_frac_q32's).
 uint32_t odo_atan2_bam(int64_t y, int64_t x);
 
 /* ---------------------------------------------------------------------------------------------
@@ -153,7 +153,8 @@ extern const uint32_t odo_sin_table_q31[ODO_SIN_TABLE_SIZE];
 /// 7e-11); x <= pi/4 keeps both in [0, 2^31]. The octant then picks which is sin and which cos
 /// of the angle and their signs: sin is +-cos x in octants 1, 2, 5, 6 and negative in octants 4..7;
 /// cos takes the other and is negative in octants 2..5, so cos(a) == sin(a + quarter) bit for bit.
-/// Each magnitude is rounded half up to Q30. Error below 1.7e-9 (tests/unit/test_trig.c).
+/// Each magnitude is rounded half up to Q30. Error below 2.5e-9 (budget in src/odo_trig.c;
+/// measured 1.7e-9, tests/unit/test_trig.c and odo-bench).
 static inline void odo_sincos_q30_inline(uint32_t angle_bam, int32_t *sin_q30, int32_t *cos_q30)
 {
     const uint32_t oct = angle_bam >> 29;
