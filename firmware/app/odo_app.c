@@ -124,8 +124,8 @@ static const uint32_t FAULT_DECODER[ODO_TRUCKS] = {ODO_FAULT_DECODER_A, ODO_FAUL
 /// Bit indices of the two faults STATUS.Rejected counts (checked against odo_status.h below).
 #define FAULT_BIT_CAN_BAD_DLC    14U
 #define FAULT_BIT_CAN_UNKNOWN_ID 15U
-typedef char fault_bit_bad_dlc_matches[(1UL << FAULT_BIT_CAN_BAD_DLC) == ODO_FAULT_CAN_BAD_DLC ? 1 : -1];
-typedef char fault_bit_unknown_id_matches[(1UL << FAULT_BIT_CAN_UNKNOWN_ID) == ODO_FAULT_CAN_UNKNOWN_ID ? 1 : -1];
+typedef char fault_bit_bad_dlc_matches[(ODO_FAULT_CAN_BAD_DLC >> FAULT_BIT_CAN_BAD_DLC) == 1U ? 1 : -1];
+typedef char fault_bit_unknown_id_matches[(ODO_FAULT_CAN_UNKNOWN_ID >> FAULT_BIT_CAN_UNKNOWN_ID) == 1U ? 1 : -1];
 
 /// One POSE_XY coordinate: mm Q32 to 10 um, saturated to int32 (the frame's +-21.47 km).
 static inline int32_t xy_10um(int64_t v_mm_q32, bool *sat)

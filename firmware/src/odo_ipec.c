@@ -18,12 +18,15 @@ void odo_ipec_init(odo_ipec_t *s) { memset(s, 0, sizeof *s); }
 
 static uint32_t abs_diff_bam16(uint16_t a, uint16_t b)
 {
-    const int32_t d = (int16_t)(uint16_t)(a - b); /* wraps: the shortest way round */
+    /* the shortest way round: the 16-bit difference read as signed, without the
+     * implementation-defined conversion of a value above INT16_MAX */
+    const uint16_t u = (uint16_t)(a - b);
+    const int32_t d = u < 0x8000U ? (int32_t)u : (int32_t)u - 65536;
     return (uint32_t)(d < 0 ? -d : d) << 16;
 }
 
 /// Half a rotary step, in BAM.
-static uint32_t half_step_bam(uint8_t rotary_bits) { return 1UL << (31U - rotary_bits); }
+static uint32_t half_step_bam(uint8_t rotary_bits) { return (uint32_t)1U << (31U - rotary_bits); }
 
 static int32_t decode_angle(uint16_t code_bam16, int32_t bias_bam, uint8_t rotary_bits)
 {
