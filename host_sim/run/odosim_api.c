@@ -255,4 +255,25 @@ char *odosim_effects_json(void)
     return buf;
 }
 
+size_t odosim_sizeof(const char *type_name)
+{
+    static const struct {
+        const char *name;
+        size_t size;
+    } sizes[] = {
+        {"odosim_tick_row_t", sizeof(odosim_tick_row_t)}, {"odosim_tick_row_ex_t", sizeof(odosim_tick_row_ex_t)},
+        {"odosim_event_t", sizeof(odosim_event_t)},       {"odosim_result_t", sizeof(odosim_result_t)},
+        {"odosim_run_opts_t", sizeof(odosim_run_opts_t)},
+    };
+    if (type_name == NULL) {
+        return 0;
+    }
+    for (size_t i = 0; i < sizeof sizes / sizeof sizes[0]; ++i) {
+        if (strcmp(sizes[i].name, type_name) == 0) {
+            return sizes[i].size;
+        }
+    }
+    return 0;
+}
+
 void odosim_free(void *p) { free(p); }

@@ -1,6 +1,8 @@
 /// The effects catalog and the scenario JSON reader; see effects.h for the schema.
 #include "effects.h"
 
+#include "robot.h"
+
 #include <errno.h>
 #include <jansson.h>
 #include <math.h>
@@ -8,6 +10,26 @@
 #include <string.h>
 
 #define ENUM_BUMP_MODEL "paper|exact"
+
+#define YES                \
+    {                      \
+        SIM_SEEN_YES, NULL \
+    }
+#define NO(why)          \
+    {                    \
+        SIM_SEEN_NO, why \
+    }
+#define WEAK(why)          \
+    {                      \
+        SIM_SEEN_WEAK, why \
+    }
+#define TWO_TRUCKS (SIM_VEHICLE_BIT(SIM_VEHICLE_CLAPPER) | SIM_VEHICLE_BIT(SIM_VEHICLE_SET))
+#define TIRE_ALIAS                                                                                  \
+    "kinematically an Ed plus an Es (off-centre load and mean load): aliased with the pair ed+es, " \
+    "reported through them"
+#define FLOOR_IN_LINKAGE                                                                           \
+    WEAK("the linkage sees a floor effect only through the difference of the two trucks: fitted, " \
+         "not named reliably")
 
 /* Sizes are typical of the papers; ranges are what the world can simulate sensibly (and, for the
  * calibration ratios, what the firmware's parameter block accepts: [0.8, 1.25], odo_params.h). */
@@ -19,7 +41,9 @@ static const sim_effect_def_t catalog[SIM_EFFECT_COUNT] = {
                        "Unequal wheel diameters: Ed = DR/DL with the mean diameter kept (000 Eq. 6.30); a straight "
                        "command curves toward the smaller wheel",
                        1,
-                       {{"value", "1", SIM_PARAM_NUMBER, 1.0, 0.8, 1.25, NULL, "Ed = DR/DL (true diameters)"}}},
+                       {{"value", "1", SIM_PARAM_NUMBER, 1.0, 0.8, 1.25, NULL, "Ed = DR/DL (true diameters)"}},
+                       .vehicles = SIM_VEHICLES_ALL,
+                       .evidence = {YES, YES, YES}},
     [SIM_EFFECT_EB] = {SIM_EFFECT_EB,
                        "eb",
                        SIM_SCOPE_TRUCK,
@@ -27,14 +51,18 @@ static const sim_effect_def_t catalog[SIM_EFFECT_COUNT] = {
                        "Wheelbase error: true b = Eb * nominal b; on-the-spot turns come out 1/Eb of the commanded "
                        "angle",
                        1,
-                       {{"value", "1", SIM_PARAM_NUMBER, 1.0, 0.8, 1.25, NULL, "Eb = b_actual/b_nominal"}}},
+                       {{"value", "1", SIM_PARAM_NUMBER, 1.0, 0.8, 1.25, NULL, "Eb = b_actual/b_nominal"}},
+                       .vehicles = SIM_VEHICLES_ALL,
+                       .evidence = {YES, YES, YES}},
     [SIM_EFFECT_ES] = {SIM_EFFECT_ES,
                        "es",
                        SIM_SCOPE_TRUCK,
                        "000 App. B, Eq. B.1",
                        "Scale error: Es = L_calc/L_actual, i.e. the true mean wheel diameter is Dn/Es",
                        1,
-                       {{"value", "1", SIM_PARAM_NUMBER, 1.0, 0.8, 1.25, NULL, "Es = L_calc/L_actual"}}},
+                       {{"value", "1", SIM_PARAM_NUMBER, 1.0, 0.8, 1.25, NULL, "Es = L_calc/L_actual"}},
+                       .vehicles = SIM_VEHICLES_ALL,
+                       .evidence = {YES, NO("closed paths do not fix the overall scale (Es)"), YES}},
     [SIM_EFFECT_BUMPS] = {SIM_EFFECT_BUMPS,
                           "bumps",
                           SIM_SCOPE_TRUCK,
@@ -44,7 +72,10 @@ static const sim_effect_def_t catalog[SIM_EFFECT_COUNT] = {
                           2,
                           {{"height_mm", "mm", SIM_PARAM_NUMBER, 10.0, 0.0, 50.0, NULL, "step height h"},
                            {"model", "-", SIM_PARAM_ENUM, (double)SIM_BUMP_EXACT, 0.0, 1.0, ENUM_BUMP_MODEL,
-                            "paper: 004 Eq. 3 chord (Table I); exact: pivot about the edge"}}},
+                            "paper: 004 Eq. 3 chord (Table I); exact: pivot about the edge"}},
+                          .vehicles = SIM_VEHICLES_ALL,
+                          .evidence = {YES, NO("return errors carry no positions of discrete events"),
+                                       NO("not located from linkage readings alone (tested in truth mode)")}},
     [SIM_EFFECT_ROUGHNESS] =
         {SIM_EFFECT_ROUGHNESS,
          "roughness",
@@ -57,7 +88,9 @@ static const sim_effect_def_t catalog[SIM_EFFECT_COUNT] = {
           {"spacing_mm", "mm", SIM_PARAM_NUMBER, 20.0, 2.0, 1000.0, NULL, "mean distance between bumps"},
           {"jitter", "1", SIM_PARAM_NUMBER, 0.5, 0.0, 0.95, NULL, "gap = spacing * (1 + jitter * U(-1, 1))"},
           {"model", "-", SIM_PARAM_ENUM, (double)SIM_BUMP_EXACT, 0.0, 1.0, ENUM_BUMP_MODEL,
-           "bump model of each grain"}}},
+           "bump model of each grain"}},
+         .vehicles = SIM_VEHICLES_ALL,
+         .evidence = {YES, YES, FLOOR_IN_LINKAGE}},
     [SIM_EFFECT_SLIP] = {SIM_EFFECT_SLIP,
                          "slip",
                          SIM_SCOPE_TRUCK,
@@ -68,24 +101,36 @@ static const sim_effect_def_t catalog[SIM_EFFECT_COUNT] = {
                          {{"k_per_m_s2", "1/(m/s^2)", SIM_PARAM_NUMBER, 0.02, 0.0, 1.0, NULL,
                            "slip fraction per m/s^2"},
                           {"a0_m_s2", "m/s^2", SIM_PARAM_NUMBER, 0.5, 0.0, 20.0, NULL, "acceleration without slip"},
-                          {"max_fraction", "1", SIM_PARAM_NUMBER, 0.2, 0.0, 0.9, NULL, "cap on the slip fraction"}}},
-    [SIM_EFFECT_SKID] = {SIM_EFFECT_SKID,
-                         "skid",
-                         SIM_SCOPE_TRUCK,
-                         "000 s. 2 (fast turning)",
-                         "Lateral skid in fast turns: outward sideways speed = k * max(0, abs(v * omega) - a0); the "
-                         "encoders do not see it",
-                         2,
-                         {{"k_s", "s", SIM_PARAM_NUMBER, 0.02, 0.0, 1.0, NULL, "lateral speed per m/s^2 of excess"},
-                          {"a0_m_s2", "m/s^2", SIM_PARAM_NUMBER, 0.3, 0.0, 20.0, NULL, "centripetal threshold"}}},
-    [SIM_EFFECT_COUNT_LOSS] = {SIM_EFFECT_COUNT_LOSS,
-                               "count_loss",
-                               SIM_SCOPE_TRUCK,
-                               "HCTL-1100 data sheet (input filter)",
-                               "Encoder count loss: the decoder's 3-clock input filter drops quadrature states faster "
-                               "than about f_CLK/3 (applied by the HCTL emulator)",
-                               1,
-                               {{"f_clk_hz", "Hz", SIM_PARAM_NUMBER, 1.0e6, 1.0e5, 2.0e6, NULL, "decoder clock"}}},
+                          {"max_fraction", "1", SIM_PARAM_NUMBER, 0.2, 0.0, 0.9, NULL, "cap on the slip fraction"}},
+                         .vehicles = SIM_VEHICLES_ALL,
+                         .evidence = {YES, YES, FLOOR_IN_LINKAGE}},
+    [SIM_EFFECT_SKID] =
+        {SIM_EFFECT_SKID,
+         "skid",
+         SIM_SCOPE_TRUCK,
+         "000 s. 2 (fast turning)",
+         "Lateral skid in fast turns: outward sideways speed = k * max(0, abs(v * omega) - a0); the "
+         "encoders do not see it",
+         2,
+         {{"k_s", "s", SIM_PARAM_NUMBER, 0.02, 0.0, 1.0, NULL, "lateral speed per m/s^2 of excess"},
+          {"a0_m_s2", "m/s^2", SIM_PARAM_NUMBER, 0.3, 0.0, 20.0, NULL, "centripetal threshold"}},
+         .vehicles = SIM_VEHICLES_ALL,
+         .evidence =
+             {YES,
+              NO("a corner's outward skid turns no heading, and around a closed path the corners' displacements cancel: k = 0.3 s moves these return poses by ~1 mm (tests/python/test_gap_evidence.py)"),
+              FLOOR_IN_LINKAGE}},
+    [SIM_EFFECT_COUNT_LOSS] =
+        {SIM_EFFECT_COUNT_LOSS,
+         "count_loss",
+         SIM_SCOPE_TRUCK,
+         "HCTL-1100 data sheet (input filter)",
+         "Encoder count loss: the decoder's 3-clock input filter drops quadrature states faster "
+         "than about f_CLK/3 (applied by the HCTL emulator)",
+         1,
+         {{"f_clk_hz", "Hz", SIM_PARAM_NUMBER, 1.0e6, 1.0e5, 2.0e6, NULL, "decoder clock"}},
+         .vehicles = SIM_VEHICLES_ALL,
+         .evidence = {YES, NO("a loss on the fast legs scales them like an Es, which closed paths do not fix"),
+                      NO("both trucks drive at one speed and lose alike: the linkage sees no difference")}},
     [SIM_EFFECT_ROTARY_BIAS] = {SIM_EFFECT_ROTARY_BIAS,
                                 "rotary_bias",
                                 SIM_SCOPE_VEHICLE,
@@ -94,8 +139,9 @@ static const sim_effect_def_t catalog[SIM_EFFECT_COUNT] = {
                                 "alpha is the joint encoder)",
                                 2,
                                 {{"alpha_deg", "deg", SIM_PARAM_NUMBER, 0.0, -10.0, 10.0, NULL, "truck A encoder bias"},
-                                 {"beta_deg", "deg", SIM_PARAM_NUMBER, 0.0, -10.0, 10.0, NULL,
-                                  "truck B encoder bias"}}},
+                                 {"beta_deg", "deg", SIM_PARAM_NUMBER, 0.0, -10.0, 10.0, NULL, "truck B encoder bias"}},
+                                .vehicles = TWO_TRUCKS,
+                                .evidence = {YES, NO("needs linkage readings"), YES}},
     [SIM_EFFECT_LINK_BIAS] = {SIM_EFFECT_LINK_BIAS,
                               "link_bias",
                               SIM_SCOPE_VEHICLE,
@@ -103,7 +149,9 @@ static const sim_effect_def_t catalog[SIM_EFFECT_COUNT] = {
                               "Link-length bias: measured l = true l + const + ecc * (1 - cos(alpha - beta)) (clapper)",
                               2,
                               {{"const_mm", "mm", SIM_PARAM_NUMBER, 0.0, -50.0, 50.0, NULL, "constant bias"},
-                               {"ecc_mm", "mm", SIM_PARAM_NUMBER, 0.0, -50.0, 50.0, NULL, "eccentric bias amplitude"}}},
+                               {"ecc_mm", "mm", SIM_PARAM_NUMBER, 0.0, -50.0, 50.0, NULL, "eccentric bias amplitude"}},
+                              .vehicles = SIM_VEHICLE_BIT(SIM_VEHICLE_CLAPPER),
+                              .evidence = {YES, NO("needs linkage readings"), YES}},
     [SIM_EFFECT_TIRE_COMPRESSION] =
         {SIM_EFFECT_TIRE_COMPRESSION,
          "tire_compression",
@@ -115,7 +163,21 @@ static const sim_effect_def_t catalog[SIM_EFFECT_COUNT] = {
          {{"k_mm_per_kg", "mm/kg", SIM_PARAM_NUMBER, 0.002, 0.0, 0.1, NULL, "radius loss per kg"},
           {"load_kg", "kg", SIM_PARAM_NUMBER, 100.0, 0.0, 2000.0, NULL, "load carried by the truck"},
           {"lateral_offset_mm", "mm", SIM_PARAM_NUMBER, 0.0, -500.0, 500.0, NULL,
-           "centre of mass left (+) of the centre; must stay within b/2"}}},
+           "centre of mass left (+) of the centre; must stay within b/2"}},
+         .vehicles = SIM_VEHICLES_ALL,
+         .evidence = {NO(TIRE_ALIAS), NO(TIRE_ALIAS), NO(TIRE_ALIAS)}},
+    [SIM_EFFECT_SCRUB] =
+        {SIM_EFFECT_SCRUB,
+         "scrub",
+         SIM_SCOPE_TRUCK,
+         "000 s. 2.2 b (contact area, not point)",
+         "Turn-radius-dependent wheelbase (tyre scrub): the heading change of the Ed/Eb/Es model times "
+         "g = 1 - k m/v, v = |dL| + |dR|, m = 2 min(|dL|, |dR|) when both wheels roll one way (else 0): "
+         "Eb on spot turns, b Eb / (1 - k (1 - b/(2R))) on an arc of radius R",
+         1,
+         {{"k", "1", SIM_PARAM_NUMBER, 0.0, -0.25, 0.25, NULL, "scrub coefficient"}},
+         .vehicles = SIM_VEHICLES_ALL,
+         .evidence = {YES, YES, WEAK("seen only through the trucks' heading difference on arcs")}},
 };
 
 const sim_effect_def_t *sim_effects_catalog(size_t *n)
@@ -224,6 +286,23 @@ int sim_effects_write_json(FILE *out)
             json_array_append_new(jp, o);
         }
         json_object_set_new(je, "params", jp);
+        json_t *jv = json_array();
+        for (unsigned v = 0; v < 3U; ++v) {
+            if (e->vehicles & SIM_VEHICLE_BIT(v)) {
+                json_array_append_new(jv, json_string(sim_vehicle_name((sim_vehicle_t)v)));
+            }
+        }
+        json_object_set_new(je, "vehicles", jv);
+        static const char *const mode_name[SIM_EVIDENCE_COUNT] = {"truth", "returns", "linkage"};
+        static const char *const seen_name[3] = {"no", "weak", "yes"};
+        json_t *jev = json_object();
+        for (unsigned m = 0; m < (unsigned)SIM_EVIDENCE_COUNT; ++m) {
+            json_t *o = json_object();
+            json_object_set_new(o, "seen", json_string(seen_name[e->evidence[m].seen]));
+            json_object_set_new(o, "why", e->evidence[m].why != NULL ? json_string(e->evidence[m].why) : json_null());
+            json_object_set_new(jev, mode_name[m], o);
+        }
+        json_object_set_new(je, "evidence", jev);
         json_array_append_new(arr, je);
     }
     const int rc = json_dumpf(root, out, JSON_INDENT(2) | JSON_PRESERVE_ORDER);

@@ -50,6 +50,7 @@ typedef enum {
     SIM_EFFECT_ROTARY_BIAS,      ///< linkage rotary encoder zero offsets
     SIM_EFFECT_LINK_BIAS,        ///< link-length bias, constant plus eccentric
     SIM_EFFECT_TIRE_COMPRESSION, ///< load-dependent rolling radius
+    SIM_EFFECT_SCRUB,            ///< turn-radius-dependent wheelbase (tyre scrub)
     SIM_EFFECT_COUNT
 } sim_effect_id_t;
 
@@ -76,6 +77,31 @@ typedef struct {
     const char *doc;     ///< one line
 } sim_param_def_t;
 
+/// The evidence a diagnosis can have about a robot (DESIGN.md s. 6): a continuous truth track, the
+/// UMBmark return poses only, or nothing but the linkage encoders of a clapper or a set.
+typedef enum {
+    SIM_EVIDENCE_TRUTH = 0,
+    SIM_EVIDENCE_RETURNS,
+    SIM_EVIDENCE_LINKAGE,
+    SIM_EVIDENCE_COUNT
+} sim_evidence_mode_t;
+
+/// How well one evidence mode sees an effect.
+typedef enum {
+    SIM_SEEN_NO = 0,   ///< not identifiable: never a hypothesis in that mode (`why` says why)
+    SIM_SEEN_WEAK = 1, ///< fitted as a hypothesis, but too faint to be named reliably (not scored)
+    SIM_SEEN_YES = 2   ///< a hypothesis the mode identifies
+} sim_seen_t;
+
+typedef struct {
+    sim_seen_t seen;
+    const char *why; ///< one line for SIM_SEEN_NO / SIM_SEEN_WEAK; NULL for SIM_SEEN_YES
+} sim_evidence_t;
+
+/// Vehicles an effect exists on (bit mask of sim_vehicle_t values, robot.h).
+#define SIM_VEHICLES_ALL   0x7U
+#define SIM_VEHICLE_BIT(v) (1U << (unsigned)(v))
+
 typedef struct {
     sim_effect_id_t id;
     const char *name; ///< JSON key in "effects"
@@ -84,6 +110,8 @@ typedef struct {
     const char *doc; ///< one line
     size_t n_params;
     sim_param_def_t params[SIM_EFFECT_MAX_PARAMS];
+    unsigned vehicles;                           ///< SIM_VEHICLE_BIT mask
+    sim_evidence_t evidence[SIM_EVIDENCE_COUNT]; ///< what each evidence mode sees of it
 } sim_effect_def_t;
 
 /// The catalog, indexed by sim_effect_id_t; *n (if not NULL) receives SIM_EFFECT_COUNT.
@@ -95,7 +123,8 @@ const sim_effect_def_t *sim_effect_find(const char *name);
 /// Index of a parameter of an effect by name; -1 iff unknown.
 int sim_effect_param_index(const sim_effect_def_t *e, const char *param);
 
-/// Print the catalog as JSON ({"effects": [{name, scope, ref, doc, params: [...]}, ...]}) or as a
+/// Print the catalog as JSON ({"effects": [{name, scope, ref, doc, params: [...], vehicles:
+/// ["labmate", ...], evidence: {"truth": {"seen": "yes|weak|no", "why": ...}, ...}}, ...]}) or as a
 /// Markdown table (name | parameters | units | defaults | doc). Return 0, or -1 on a write error.
 int sim_effects_write_json(FILE *out);
 int sim_effects_write_markdown(FILE *out);
@@ -175,5 +204,6 @@ enum { SIM_P_COUNT_LOSS_F_CLK = 0 };
 enum { SIM_P_ROTARY_ALPHA = 0, SIM_P_ROTARY_BETA = 1 };
 enum { SIM_P_LINK_CONST = 0, SIM_P_LINK_ECC = 1 };
 enum { SIM_P_TIRE_K = 0, SIM_P_TIRE_LOAD = 1, SIM_P_TIRE_OFFSET = 2 };
+enum { SIM_P_SCRUB_K = 0 };
 
 #endif

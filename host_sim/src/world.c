@@ -300,11 +300,11 @@ static void reach_bumps(sim_world_t *w, unsigned t, unsigned wh, double hor)
  * ------------------------------------------------------------------------------------------- */
 /* Move a truck by horizontal wheel advances (signed) along the exact arc of constant curvature
  * (000 Eqs. 2.3-2.5 with the chord of the arc instead of Eq. 2.6's tangent), plus a sideways
- * displacement `lateral` (body y). */
-static void move_truck(sim_truck_state_t *ts, double du_l, double du_r, double lateral)
+ * displacement `lateral` (body y); the heading change is scaled by `turn_factor` (scrub_factor). */
+static void move_truck(sim_truck_state_t *ts, double du_l, double du_r, double lateral, double turn_factor)
 {
     const double d = 0.5 * (du_l + du_r);
-    const double dth = (du_r - du_l) / ts->b_true_mm;
+    const double dth = turn_factor * (du_r - du_l) / ts->b_true_mm;
     const double half = 0.5 * dth;
     const double chord = fabs(half) > 1e-9 ? d * sin(half) / half : d;
     const double mid = ts->pose.theta_rad + half;
@@ -382,6 +382,25 @@ static double hidden_backlash(const sim_world_t *w, sim_wheel_state_t *ws, doubl
     return rot;
 }
 
+/* Tyre scrub (catalog `scrub`): the heading change of the Ed/Eb/Es model times g = 1 - k m / v,
+ * v = |dL| + |dR|, m = 2 min(|dL|, |dR|) when both wheels roll one way (else 0). m / v = 1 - s with
+ * s = |dR - dL| / v the spin fraction: 1 on the spot (g = 1, Eb alone), b / (2R) on an arc of
+ * radius R (effective wheelbase b Eb / (1 - k (1 - s))), 0 straight. Taken from the floor advances
+ * of each physics step; the firmware's correction takes it from each tick's counts (the same
+ * ratio wherever the wheel speeds hold over a tick). */
+static double scrub_factor(const sim_world_t *w, unsigned t, double du_l, double du_r)
+{
+    if (!eff_on(w, SIM_EFFECT_SCRUB, t)) {
+        return 1.0;
+    }
+    const double v = fabs(du_l) + fabs(du_r);
+    if (!(v > 0.0) || !((du_l > 0.0 && du_r > 0.0) || (du_l < 0.0 && du_r < 0.0))) {
+        return 1.0;
+    }
+    const double m = 2.0 * fmin(fabs(du_l), fabs(du_r));
+    return 1.0 - eff_p(w, SIM_EFFECT_SCRUB, t, SIM_P_SCRUB_K) * m / v;
+}
+
 static void step_driven(sim_world_t *w, unsigned t, double dt, const double cmd_in[2])
 {
     sim_truck_state_t *ts = &w->truck[t];
@@ -402,17 +421,18 @@ static void step_driven(sim_world_t *w, unsigned t, double dt, const double cmd_
         du[wh] = arc < 0.0 ? -hor : hor;
     }
     double lateral = 0.0;
+    const double g = scrub_factor(w, t, du[0], du[1]);
     if (eff_on(w, SIM_EFFECT_SKID, t)) {
-        const double v = 0.5 * (du[0] + du[1]) / dt;            /* mm/s */
-        const double om = (du[1] - du[0]) / ts->b_true_mm / dt; /* rad/s */
-        const double ac = v * om * 1e-3;                        /* m/s^2, + centre on the left */
+        const double v = 0.5 * (du[0] + du[1]) / dt;                /* mm/s */
+        const double om = g * (du[1] - du[0]) / ts->b_true_mm / dt; /* rad/s */
+        const double ac = v * om * 1e-3;                            /* m/s^2, + centre on the left */
         const double a0 = eff_p(w, SIM_EFFECT_SKID, t, SIM_P_SKID_A0);
         if (fabs(ac) > a0) {
             const double vlat = eff_p(w, SIM_EFFECT_SKID, t, SIM_P_SKID_K) * (fabs(ac) - a0) * 1e3; /* mm/s */
             lateral = (ac > 0.0 ? -vlat : vlat) * dt; /* outward, away from the centre */
         }
     }
-    move_truck(ts, du[0], du[1], lateral);
+    move_truck(ts, du[0], du[1], lateral, g);
     for (unsigned wh = 0; wh < 2U; ++wh) {
         reach_bumps(w, t, wh, fabs(du[wh]));
     }

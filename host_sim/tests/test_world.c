@@ -218,6 +218,43 @@ START_TEST(eb_scales_on_the_spot_turns_by_one_over_eb)
 }
 END_TEST
 
+START_TEST(scrub_leaves_spot_turns_to_eb_and_widens_the_wheelbase_on_arcs)
+{
+    /* 000 s. 2.2 b: a tyre touches the floor in an area, so the effective wheelbase need not be one
+     * number. Catalog `scrub`: on the spot the turn is 1/Eb of the nominal (as without scrub); on
+     * an arc of radius R the effective wheelbase is b Eb / (1 - k (1 - b/(2R))); straight it does
+     * nothing. Checked against that closed form for two radii and both signs of k. */
+    const sim_robot_t r = labmate();
+    const double b = 340.0, eb = 1.01;
+    const double ks[] = {0.05, -0.1};
+    for (int i = 0; i < 2; ++i) {
+        sim_scenario_t sc;
+        char err[256];
+        sim_scenario_none(&sc);
+        must(sim_scenario_set(&sc, "eb", "value", 3U, eb, err, sizeof err), err);
+        must(sim_scenario_set(&sc, "scrub", "k", 3U, ks[i], err, sizeof err), err);
+        must(sim_world_init(&g_world, &r, &sc, 1U, err, sizeof err), err);
+        turn_on_spot(&g_world, 90.0, b);
+        ck_assert_double_eq_tol(DEG(sim_world_pose(&g_world, 0).theta_rad), 90.0 / eb, 1e-9);
+        const double radii[] = {500.0, 2000.0};
+        for (int j = 0; j < 2; ++j) {
+            must(sim_world_init(&g_world, &r, &sc, 1U, err, sizeof err), err);
+            const double R = radii[j], v = 200.0;
+            const double vl = v * (R - 0.5 * b) / R, vr = v * (R + 0.5 * b) / R;
+            drive(&g_world, 2.0, vl, vr);
+            const double s = b / (2.0 * R);
+            const double nominal = (vr - vl) * 2.0 / (b * eb);
+            const double expect = nominal * (1.0 - ks[i] * (1.0 - s));
+            ck_assert_double_eq_tol(sim_world_pose(&g_world, 0).theta_rad, expect, 1e-12);
+        }
+        must(sim_world_init(&g_world, &r, &sc, 1U, err, sizeof err), err);
+        straight(&g_world, 1000.0);
+        ck_assert_double_eq_tol(sim_world_pose(&g_world, 0).theta_rad, 0.0, 1e-15);
+        ck_assert_double_eq_tol(sim_world_pose(&g_world, 0).x_mm, 1000.0, 1e-9);
+    }
+}
+END_TEST
+
 START_TEST(es_makes_the_true_distance_the_calculated_one_over_es)
 {
     /* 000 App. B, Eq. B.1: Es = L_calc / L_actual. */
@@ -657,6 +694,7 @@ static Suite *suite(void)
     tcase_add_test(tc, straight_run_over_one_bump_turns_toward_the_bumped_wheel_by_dtheta);
     tcase_add_test(tc, ed_above_one_makes_a_straight_command_curve_left);
     tcase_add_test(tc, eb_scales_on_the_spot_turns_by_one_over_eb);
+    tcase_add_test(tc, scrub_leaves_spot_turns_to_eb_and_widens_the_wheelbase_on_arcs);
     tcase_add_test(tc, es_makes_the_true_distance_the_calculated_one_over_es);
     tcase_add_test(tc, uni_directional_square_hides_compensating_ed_and_eb_that_umbmark_exposes);
     tcase_add_test(tc, same_seed_gives_bit_identical_worlds_and_another_seed_differs);

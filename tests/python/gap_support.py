@@ -36,3 +36,12 @@ def odo_sim(scenario: str, out: Path, runs: int = 1, experiment: str = "umbmark"
                     "--vehicle", "labmate", "--scenario",
                     str(SRC / "host_sim/scenarios" / scenario),
                     "--runs", str(runs), "--out", str(out)], check=True, timeout=300)
+
+
+def optiodom_dir() -> Path | None:
+    """../shared/data/optiodom beside the repository (a worktree sits one level deeper)."""
+    for base in (SRC.parent, SRC.parent.parent):
+        d = base / "shared" / "data" / "optiodom"
+        if d.is_dir():
+            return d
+    return None

@@ -18,7 +18,7 @@ def report(tmp_path_factory: pytest.TempPathFactory) -> Path:
     odo_sim("effect-ed.json", tmp / "real", runs=3)
     out = tmp / "report"
     code = (
-        "import sys; from odo_tools.gap.blind import guard; "
+        "import sys; from odo_tools.validation.blind import guard; "
         f"guard({str(SRC / 'host_sim' / 'scenarios')!r}); "
         "from odo_tools.gap.cli import main; "
         f"sys.exit(main(['diagnose', '--real', {str(tmp / 'real')!r}, '--robot', "

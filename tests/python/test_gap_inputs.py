@@ -33,7 +33,7 @@ def fails(real: Path, tmp: Path, *expect: str, robot: str = LABMATE, extra=()) -
     assert r.returncode != 0, r.stderr
     for e in expect:
         assert e in r.stderr, (e, r.stderr)
-    assert not out.exists() and not list(tmp.glob("report.tmp.*")), "partial report left"
+    assert not out.exists() and not list(tmp.glob("*report.tmp*")), "partial report left"
 
 
 def test_missing_folder(tmp_path: Path) -> None:
@@ -112,3 +112,69 @@ def test_bad_linkage_range(good: Path, tmp_path: Path, rng) -> None:
     rp = tmp_path / "clapper-range.json"
     rp.write_text(json.dumps(r))
     fails(good, tmp_path, "clapper-range.json", "linkage.range_mm", robot=str(rp))
+
+
+@pytest.mark.parametrize("extra,expect", [(("--seed", "-1"), "--seed must be 0 or more, got -1"),
+                                          (("--holdout", "1"), "--holdout must be in [0, 1)")])
+def test_bad_option_value_is_one_line_exit_1(good: Path, tmp_path: Path, extra, expect) -> None:
+    out = tmp_path / "report"
+    r = odo_gap("diagnose", "--real", str(good), "--robot", LABMATE, "--out", str(out), "--quiet",
+                *extra)
+    assert r.returncode == 1 and r.stderr.count("\n") == 1 and expect in r.stderr, r.stderr
+    assert not out.exists()
+
+
+@pytest.mark.parametrize("extra,expect", [(("--cases", "0"), "--cases must be at least 1, got 0"),
+                                          (("--seed", "-1"), "--seed must be 0 or more, got -1"),
+                                          (("--workers", "0"), "--workers must be at least 1")])
+def test_blind_bad_option_value_is_one_line_exit_1(tmp_path: Path, extra, expect) -> None:
+    out = tmp_path / "blind"
+    r = odo_gap("blind", "--out", str(out), "--quiet", *extra)
+    assert r.returncode == 1 and r.stderr.count("\n") == 1 and expect in r.stderr, r.stderr
+    assert not out.exists() and not list(tmp_path.iterdir())
+
+
+def test_report_folder_rule(good: Path, tmp_path: Path) -> None:
+    """The output rule (odo_tools/outpath.py): a user's folder is refused and kept; an empty one
+    is filled; a previous report is replaced file by file (its manifest), and the user's own
+    files in it stay."""
+    out = tmp_path / "report"
+    out.mkdir()
+    (out / "notes.txt").write_text("mine")
+    args = ("diagnose", "--real", str(good), "--robot", LABMATE, "--out", str(out), "--quiet")
+    r = odo_gap(*args)
+    assert r.returncode == 1 and "odo-gap did not write" in r.stderr and r.stderr.count("\n") == 1
+    assert sorted(p.name for p in out.iterdir()) == ["notes.txt"]
+    assert not list(tmp_path.glob("*report.tmp*"))
+    (out / "notes.txt").unlink()
+    r = odo_gap(*args)  # empty folder: filled
+    assert r.returncode == 0, r.stderr
+    manifest = (out / ".odo-manifest").read_text().splitlines()
+    assert manifest[:2] == ["odo-out-manifest 1", "tool odo-gap"]
+    assert "report.json" in manifest and "report.md" in manifest
+    assert sorted(manifest[2:]) == sorted(p.name for p in out.iterdir() if p.name[0] != ".")
+    (out / "notes.txt").write_text("mine")
+    (out / "mine").mkdir()
+    (out / "mine" / "plot.png").write_bytes(b"x")
+    r = odo_gap(*args)  # a previous report: its files replaced, the user's kept
+    assert r.returncode == 0, r.stderr
+    assert (out / "notes.txt").read_text() == "mine" and (out / "mine" / "plot.png").exists()
+    assert json.loads((out / "report.json").read_text())["verdict"]
+    assert not list(tmp_path.glob("*report.tmp*"))
+    f = tmp_path / "afile"
+    f.write_text("mine")
+    r = odo_gap("diagnose", "--real", str(good), "--robot", LABMATE, "--out", str(f), "--quiet")
+    assert r.returncode == 1 and "not a folder" in r.stderr and f.read_text() == "mine"
+    # --force writes into a user's folder: same-named files replaced, nothing removed
+    mine = tmp_path / "mine"
+    mine.mkdir()
+    (mine / "notes.txt").write_text("mine")
+    (mine / "report.md").write_text("old")
+    r = odo_gap("diagnose", "--real", str(good), "--robot", LABMATE, "--out", str(mine),
+                "--quiet", "--force")
+    assert r.returncode == 0, r.stderr
+    assert (mine / "notes.txt").read_text() == "mine" and (mine / "report.md").read_text() != "old"
+    # an output inside an input folder is refused before anything is written
+    r = odo_gap("diagnose", "--real", str(good), "--robot", LABMATE, "--out", str(good / "rep"),
+                "--quiet")
+    assert r.returncode == 1 and r.stderr.count("\n") == 1 and not (good / "rep").exists()

@@ -80,8 +80,8 @@ def test_slip_loss_matches_the_simulators_law_seen_through_40ms_counts(
 
 @pytest.mark.parametrize("vehicle", ["clapper", "set"])
 def test_a_no_effect_two_truck_vehicle_is_no_significant_gap(vehicle: str, tmp_path: Path) -> None:
-    from odo_tools.gap import blind
     from odo_tools.gap.diagnose import diagnose
+    from odo_tools.validation import blind
 
     case = {"case": 0, "vehicle": vehicle, "kind": "none", "effects": [], "params": {},
             "hidden": {}, "n_bumps": 0,
@@ -145,8 +145,8 @@ def test_drive_effects_do_not_act_on_a_passive_trailer() -> None:
     w = np.column_stack([v, 1.05 * v])
     P = {"slip.k_per_m_s2": 1.0, "skid.k_s": 0.3, "skid.a0_m_s2": 0.0}
     pr = _two_trucks(w, w, driven=(True, False))
-    da, _, la = floor_travel(pr, P, 0)
-    db, _, lb = floor_travel(pr, P, 1)
+    da, _, la, _ = floor_travel(pr, P, 0)
+    db, _, lb, _ = floor_travel(pr, P, 1)
     assert not np.allclose(da, w) and np.abs(la).max() > 0  # the driven truck slips and skids
     assert np.allclose(db, w) and np.allclose(lb, 0.0)
 

@@ -120,8 +120,8 @@ def test_bad_source_date_epoch_is_refused(tmp_path):
     h = subprocess.run([str(SIM), "--help"], capture_output=True, text=True,
                        env={**os.environ, "SOURCE_DATE_EPOCH": "yesterday"})
     assert h.returncode == 0 and "--log-start" in h.stdout
-    bad_epoch = {**os.environ, "SOURCE_DATE_EPOCH": "yesterday"}
-    r = sim(tmp_path / "given", "--log-start", "0", env=bad_epoch)
+    r = sim(tmp_path / "given", "--log-start", "0",
+            env={**os.environ, "SOURCE_DATE_EPOCH": "yesterday"})
     assert r.returncode == 0, r.stderr
 
 

@@ -120,6 +120,12 @@ int odosim_run_ex(const odosim_setup_t *s, const odosim_run_opts_t *opts, odosim
 /// The effects catalog as a JSON document (malloc'd; release with odosim_free), or NULL.
 char *odosim_effects_json(void);
 
+/// sizeof of one of this header's structs, by its type name ("odosim_tick_row_ex_t",
+/// "odosim_event_t", "odosim_result_t", "odosim_run_opts_t", "odosim_tick_row_t"); 0 iff the name
+/// is unknown. Bindings in other languages (tools/python/odo_tools/gap/simlib.py) check their
+/// layouts against it, so a field added here fails a test instead of corrupting memory.
+size_t odosim_sizeof(const char *type_name);
+
 void odosim_free(void *p);
 
 /* ---------------------------------------------------------------------------------------------

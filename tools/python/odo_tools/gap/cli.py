@@ -14,12 +14,42 @@ def _progress(quiet: bool):
     return None if quiet else (lambda s: print(f"odo-gap: {s}", file=sys.stderr, flush=True))
 
 
+EPILOG = """examples:
+  odo-gap diagnose --real out/umbmark --robot host_sim/robots/labmate.json --out out/gap
+  odo-gap diagnose --real out/opt-square out/opt-circular --robot R.json \\
+      --fit 'opt-square/*' 'opt-circular/run-*-0[12]' --out out/opt-gap
+  odo-gap blind --world both --cases 60 --seed 41 --out out/blind
+"""
+
+
+class _Usage(Exception):
+    """A bad option value: one line on stderr, exit 1, nothing written."""
+
+
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(prog="odo-gap", description=__doc__)
+    ap = argparse.ArgumentParser(
+        prog="odo-gap",
+        description=__doc__,
+        epilog=EPILOG,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
     sub = ap.add_subparsers(dest="cmd", required=True)
-    d = sub.add_parser("diagnose", help="diagnose recorded runs (never reads a scenario)")
+    d = sub.add_parser(
+        "diagnose",
+        help="diagnose recorded runs (never reads a scenario)",
+        description="Where the gap between the nominal model and recorded runs lies, which "
+        "effect causes it, and how far it shrinks on held-out runs. Writes OUT/report.md, "
+        "report.json and plots by the output rule: built in a fresh temp folder beside OUT and "
+        "moved into place; an existing OUT is written into only when it holds odo-gap's "
+        "manifest (then only the files it lists are replaced) or with --force.",
+    )
     d.add_argument(
-        "--real", required=True, help="folder of run-<dir>-NN.log (+ .truth.csv, returns.csv)"
+        "--real",
+        required=True,
+        nargs="+",
+        metavar="DIR",
+        help="folder(s) of run-<dir>-NN.log (+ .truth.csv, returns.csv); each folder is one "
+        "recording session",
     )
     d.add_argument(
         "--robot", required=True, help="robot description JSON (what the firmware believes)"
@@ -27,7 +57,28 @@ def main(argv: list[str] | None = None) -> int:
     d.add_argument(
         "--holdout", type=float, default=0.5, help="fraction of runs held out (default 0.5)"
     )
-    d.add_argument("--seed", type=int, default=1)
+    d.add_argument("--seed", type=int, default=1, help="seed of the random hold-out split")
+    d.add_argument(
+        "--fit",
+        nargs="+",
+        metavar="GLOB",
+        help="fit on these runs only: globs on run names ('square/run-cw-0[12]'; with several "
+        "folders names carry the folder), log paths, or group:NAME (a folder or a --group)",
+    )
+    d.add_argument(
+        "--judge",
+        nargs="+",
+        metavar="GLOB",
+        help="judge on these runs (default with --fit: every run not fitted)",
+    )
+    d.add_argument(
+        "--group",
+        action="append",
+        default=[],
+        metavar="GLOB=LABEL",
+        help="put the runs matching GLOB into group LABEL (repeatable; two runs or more per "
+        "group): parameters are compared across groups, and --fit/--judge take group:LABEL",
+    )
     d.add_argument(
         "--mode",
         choices=["truth", "returns", "linkage"],
@@ -37,22 +88,48 @@ def main(argv: list[str] | None = None) -> int:
         "--return-accuracy",
         metavar="MM,DEG",
         help="accuracy (one sigma) of the measured return poses, e.g. 1,0.02 for a tape and a "
-        "protractor: returns mode then judges their spread against it (roughness); without it "
-        "the spread is the noise",
+        "protractor (default: a folder's instrument.json, else none): the returns' spread is "
+        "judged against the larger of it and the runs' own spread",
     )
     d.add_argument("--out", required=True)
+    d.add_argument(
+        "--force",
+        action="store_true",
+        help="write into a non-empty OUT odo-gap did not write (same-named files replaced, "
+        "nothing removed)",
+    )
     d.add_argument("--quiet", action="store_true")
-    b = sub.add_parser("blind", help="the withheld-effect check: generate, diagnose, score")
+    b = sub.add_parser(
+        "blind",
+        help="the withheld-effect check: generate, diagnose, score",
+        description="Draw cases with hidden effects, simulate their recordings in one or both "
+        "worlds, diagnose them in processes that cannot open the keys, and score.",
+    )
     b.add_argument("--cases", type=int, default=60)
     b.add_argument("--seed", type=int, default=1)
+    b.add_argument(
+        "--world",
+        choices=["sim", "independent", "both"],
+        default="sim",
+        help="sim: host_sim with hidden effects; independent: a generator that shares no code or "
+        "effect law with it (validation.indep); both: each, scored separately",
+    )
     b.add_argument("--out", required=True)
+    b.add_argument(
+        "--force",
+        action="store_true",
+        help="write into a non-empty OUT odo-gap blind did not write (same-named files replaced, "
+        "nothing removed)",
+    )
     b.add_argument("--workers", type=int, default=2, help="processes (at most 2)")
     b.add_argument("--quiet", action="store_true")
     a = ap.parse_args(argv)
     try:
         if a.cmd == "diagnose":
             if not 0.0 <= a.holdout < 1.0:
-                ap.error("--holdout must be in [0, 1)")
+                raise _Usage(f"--holdout must be in [0, 1), got {a.holdout:g}")
+            if a.seed < 0:
+                raise _Usage(f"--seed must be 0 or more, got {a.seed}")
             acc = None
             if a.return_accuracy is not None:
                 try:
@@ -60,26 +137,49 @@ def main(argv: list[str] | None = None) -> int:
                 except ValueError:
                     acc = ()
                 if len(acc) != 2 or not all(math.isfinite(x) and x > 0 for x in acc):
-                    ap.error("--return-accuracy: expected MM,DEG, two positive numbers")
-            from .diagnose import diagnose, write_report
+                    raise _Usage("--return-accuracy: expected MM,DEG, two positive numbers")
+            from .diagnose import diagnose
+            from .report import write_report
 
             t0 = time.perf_counter()
-            rep = diagnose(a.real, a.robot, a.holdout, a.seed, a.mode, _progress(a.quiet), acc)
-            write_report(rep, a.out)
-            v = rep["verdict"]
+            rep = diagnose(
+                a.real,
+                a.robot,
+                a.holdout,
+                a.seed,
+                a.mode,
+                _progress(a.quiet),
+                acc,
+                fit=a.fit,
+                judge_runs=a.judge,
+                groups=a.group,
+            )
+            write_report(rep, a.out, a.force, [*a.real, a.robot])
+            v = rep.verdict
+            h = rep.heldout
             print(
-                f"odo-gap: verdict {v['effect']} (best {v['best_candidate']}, dBIC "
-                f"{v['evidence']['dbic_vs_nominal']:.1f}); held-out gap {rep['gap_before']:.2f} -> "
-                f"{rep['gap_after_heldout']:.2f} (x{rep['shrink']:.1f}); "
+                f"odo-gap: verdict {v['effect']} (best {v['best_hypothesis']}, dBIC "
+                f"{v['evidence']['dbic_vs_nominal']:.1f}); held-out {h['mm_before']:.1f} -> "
+                f"{h['mm_after']:.1f} mm (background {rep.background['heldout_allowance_mm']:.1f}"
+                f" mm; misfit {h['ratio_before']:.2f} -> {h['ratio_after']:.2f} x background); "
                 f"{time.perf_counter() - t0:.1f} s -> {a.out}",
                 file=sys.stderr,
             )
             return 0
-        from .blind import run_blind
+        from ..validation.blind import run_blind
 
-        run_blind(a.cases, a.seed, a.out, min(2, max(1, a.workers)), _progress(a.quiet))
+        worlds = ("sim", "independent") if a.world == "both" else (a.world,)
+        if a.cases < 1:
+            raise _Usage(f"--cases must be at least 1, got {a.cases}")
+        if a.seed < 0:
+            raise _Usage(f"--seed must be 0 or more, got {a.seed}")
+        if a.workers < 1:
+            raise _Usage(f"--workers must be at least 1, got {a.workers}")
+        run_blind(
+            a.cases, a.seed, a.out, min(2, max(1, a.workers)), _progress(a.quiet), worlds, a.force
+        )
         return 0
-    except GapInputError as e:
+    except (GapInputError, _Usage) as e:
         print(f"odo-gap: {e}", file=sys.stderr)
         return 1
 

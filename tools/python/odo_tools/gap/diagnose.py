@@ -1,44 +1,88 @@
-"""odo-gap diagnose: where the gap lies, which effect causes it, how far it shrinks (DESIGN s.6)"""
+"""odo-gap diagnose: where the gap lies, which effect causes it, how far it shrinks (DESIGN s.6).
+
+Three steps, each its own function:
+
+1. `load`: runs of one or more folders (one recording session each) against one robot
+   description, the evidence mode, the truth's instrument nuisances (lever arm, latency), the
+   per-run evidence objects (modes.EvidenceMode).
+2. `rank` on the fitting runs: every hypothesis the mode sees (hypotheses.singles), the other
+   laws of the families the residual points to (hypotheses.propose), pairs and a third member
+   where they pay for themselves; evidence is BIC, pairs by quasi-BIC.
+3. `judge` on the held-out runs (select.py chooses them): the measured background
+   (background.py), the best candidate's held-out gap against it (heldout.py), the verdict
+   (`decide`), and the parameters' stability across groups (stability.py).
+
+`diagnose` runs the three and returns a report.Report; report.write_report writes it.
+"""
 
 from __future__ import annotations
 
 import itertools
-import json
 import math
-import os
-import shutil
 import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
+from . import catalog, hypotheses, instrument
+from .background import Background, measure
+from .bumps import clear_bumps, cluster_bumps, detect_bumps
 from .errors import GapInputError
 from .fit import (
-    ALWAYS_UNIDENTIFIABLE,
     DBIC_PAIR,
     DBIC_SIGNIFICANT,
-    EXPLAINED_MIN,
-    UNIDENTIFIABLE,
     Z_GAP,
     Fit,
     Problem,
-    applicable,
-    assign_paths,
-    clear_bumps,
-    cluster_bumps,
-    detect_bumps,
     evaluate,
+    fit_hypothesis,
     fit_params,
-    free_params,
-    group_key,
-    place_bumps,
 )
-from .io import RunData, discover, read_robot
-from .model import prepare
-from .modes import MODES, TruthMode
+from .heldout import HeldOut, apply
+from .heldout import evaluate as evaluate_heldout
+from .io import Robot, RunData, discover_all, read_robot
+from .model import Prepared, prepare
+from .modes import MODES, Instrument, TruthMode
+from .paths import assign_paths, assign_shapes, group_key
+from .report import Context, Report
+from .select import Selection, explicit, parse_groups, stratified
+from .stability import analyse as stability
+from .verdict import R_WITHIN, decide
+from .where import phase_excess, truck_excess, where_analysis
+
+Progress = Callable[[str], None] | None
+
+# bump detection is most of a diagnosis's time: partners under which the single's floor bumps
+# are reused (they move nothing the step detector sees)
+BUMPS_REUSE_WITH = {"ed", "skid", "rotary_bias", "link_bias", "scrub"}
+# roughness inflates the variance: it can come first among the singles by absorbing another
+# effect's systematic misfit, so it is paired with the best others instead of taking their place
+ABSORBERS = {"roughness"}
+N_PAIR_BASE = 4
+N_THIRD = 4
+# a third member is one of the robot's geometry (Ed, Eb, Es and a scrub come together on a real
+# robot: the OptiOdom wheelbase needs both Eb and a scrub), never a floor or drive law
+THIRDS = ("ed", "eb", "es", "scrub")
 
 
-def pick_mode(runs: list[RunData], vehicle: str, want: str | None, real: Path) -> str:
+@dataclass
+class Dataset:
+    robot: Robot
+    robot_path: str
+    real: list[Path]
+    runs: list[RunData]
+    prs: list[Prepared]
+    items: list
+    mode: str
+    groups: dict[str, str]
+    return_accuracy: tuple[float, float] | None
+    instrument: Instrument | None = None
+    notes: list[str] = field(default_factory=list)
+
+
+def pick_mode(runs: list[RunData], vehicle: str, want: str | None, real) -> str:
     have = {
         "truth": all(r.truth is not None for r in runs),
         "returns": all(r.ret is not None for r in runs),
@@ -63,513 +107,506 @@ def pick_mode(runs: list[RunData], vehicle: str, want: str | None, real: Path) -
     )
 
 
-def split(
-    runs: list[RunData], frac: float, seed: int, keys: list[str] | None = None
-) -> tuple[list[int], list[int]]:
-    """Held-out runs, stratified by direction (and by path when `keys` name it: each group of
-    runs keeps at least one fitting run; frac of each group, at least one, is held out)."""
-    rng = np.random.default_rng(seed)
-    fit, held = [], []
-    keys = keys or [r.direction for r in runs]
-    for d in sorted(set(keys)):
-        idx = [i for i, k in enumerate(keys) if k == d]
-        nh = min(len(idx) - 1, max(1, int(frac * len(idx)))) if frac > 0 else 0
-        perm = list(rng.permutation(idx))
-        held += sorted(perm[:nh])
-        fit += sorted(perm[nh:])
-    return sorted(fit), sorted(held)
+def load(
+    real: str | Path | list,
+    robot_path: str | Path,
+    mode: str | None = None,
+    return_accuracy: tuple[float, float] | None = None,
+    group_specs: list[str] | None = None,
+) -> Dataset:
+    """Step 1: read and check everything (GapInputError on anything bad; nothing is written)."""
+    robot = read_robot(robot_path)
+    folders = [Path(p) for p in (real if isinstance(real, (list, tuple)) else [real])]
+    runs = discover_all(folders, robot)
+    if len(runs) < 2:
+        raise GapInputError(folders[0], "needs at least two runs (one to fit, one to hold out)")
+    groups = parse_groups(group_specs or [], runs)
+    mode = pick_mode(runs, robot.vehicle, mode, folders[0])
+    if return_accuracy is None:
+        return_accuracy = recorded_accuracy(folders)
+    prs = [prepare(r, robot) for r in runs]
+    assign_paths(prs)
+    assign_shapes(prs)
+    ds = Dataset(robot, str(robot_path), folders, runs, prs, [], mode, groups, return_accuracy)
+    try:
+        if mode == "truth":
+            ds.instrument, ds.notes = instrument.estimate(prs, robot.n_trucks)
+            ds.items = [TruthMode(pr, robot, ds.instrument) for pr in prs]
+            if ds.notes:
+                _lever_on_arcs(ds)
+        elif mode == "returns":
+            acc = None
+            if return_accuracy is not None:
+                mm, deg = return_accuracy
+                acc = (mm, mm, math.radians(deg))
+            ds.items = [MODES[mode](pr, robot, acc) for pr in prs]
+        else:
+            ds.items = [MODES[mode](pr, robot) for pr in prs]
+    except ValueError as e:
+        raise GapInputError(folders[0], f"mode {mode}: {e}") from None
+    return ds
 
 
-def explained(null: Fit, f: Fit, e0: float) -> float:
-    """Share of the nominal model's misfit above the noise-only level e0 that f removes."""
-    excess = null.chi - e0
-    if excess <= 0:
-        return 0.0
-    return float(np.clip((null.chi - f.chi) / excess, -1.0, 1.0))
+def _lever_on_arcs(ds: Dataset) -> None:
+    """Trucks whose lever arm the spot turns could not give: estimated on arcs, alternating with
+    a preliminary fit of the robot's geometry (the lever arm moves increments sideways, the
+    geometry turns the heading: two rounds settle them)."""
+    keys = [k for k in PRELIM if k.split(".")[0] in catalog.hypotheses("truth", ds.robot.vehicle)]
+    for _ in range(2):
+        prob = Problem("truth", ds.items)
+        P, _ = fit_params(prob, keys)
+        notes = []
+        for t in range(ds.robot.n_trucks):
+            if not any(n.startswith(f"truck {'AB'[t]}:") for n in ds.notes):
+                continue
+            o, se, n = instrument.on_arcs(ds.instrument, ds.prs, t, P)
+            if o is None:
+                notes.append(
+                    f"truck {'AB'[t]}: lever arm of the tracked point not estimated (no turns on "
+                    "the spot, too few arcs): taken as zero"
+                )
+                continue
+            ds.instrument.lever_se_mm[t] = se
+            ds.instrument.lever_mm[t] = o if instrument.significant(o, se) else (0.0, 0.0)
+            if t == 0:  # the latency again, with this lever arm
+                wt = [pr for pr in ds.prs if pr.run.truth is not None]
+                found = {
+                    pr.run.name: instrument.latency(pr, lever=ds.instrument.lever_mm[0])
+                    for pr in wt
+                }
+                ds.instrument.latency_s.update(instrument.session_latencies(wt, found))
+            notes.append(
+                f"truck {'AB'[t]}: no turns on the spot: lever arm from {n} windows on arcs, "
+                "under a preliminary fit of Ed, Eb, Es and scrub"
+            )
+        ds.items = [TruthMode(pr, ds.robot, ds.instrument) for pr in ds.prs]
+    ds.notes = notes
 
 
-def qbic(f: Fit, c_hat: float) -> float:
-    return f.dev / c_hat + f.k * math.log(max(f.n, 2))
+def recorded_accuracy(folders: list[Path]) -> tuple[float, float] | None:
+    """The return measurement's accuracy a recording states about itself (instrument.json:
+    return_accuracy_mm, return_accuracy_deg); the smallest stated over the folders, or None."""
+    import json
+
+    got = []
+    for f in folders:
+        p = f / "instrument.json"
+        if not p.is_file():
+            continue
+        try:
+            d = json.loads(p.read_text())
+            mm, deg = float(d["return_accuracy_mm"]), float(d["return_accuracy_deg"])
+        except (OSError, ValueError, KeyError, TypeError):
+            raise GapInputError(
+                p, 'expected {"return_accuracy_mm": MM, "return_accuracy_deg": DEG}'
+            ) from None
+        if not (math.isfinite(mm) and math.isfinite(deg) and mm > 0 and deg > 0):
+            raise GapInputError(p, "return accuracies must be positive numbers")
+        got.append((mm, deg))
+    return min(got) if got else None
 
 
-def fit_hypothesis(
-    name: str,
-    prob: Problem,
-    prs: list,
-    vehicle: str,
-    sig_head: float,
-    base: Fit | None = None,
-    floor_bumps: list | None = None,
-    warm: dict | None = None,
-) -> Fit:
-    """A single effect or a pair 'a+b'."""
-    parts = name.split("+")
-    keys = [k for p in parts if p != "bumps" for k in free_params(p, vehicle)]
-    clear_bumps(prs)
-    if "bumps" not in parts:
-        P, se = fit_params(prob, keys, warm=warm)
-        return evaluate(prob, name, P, se, len(keys))
-    if floor_bumps is not None:
-        # detection is most of a diagnosis's time: the caller passes the floor bumps found
-        # under a model fit for this pair (diagnose: bumps_for)
-        fb = floor_bumps
+def select_runs(
+    ds: Dataset,
+    holdout: float = 0.5,
+    seed: int = 1,
+    fit: list[str] | None = None,
+    judge: list[str] | None = None,
+) -> Selection:
+    if fit:
+        return explicit(ds.runs, fit, judge, ds.groups)
+    if judge:
+        raise GapInputError("--judge", "needs --fit too (which runs to fit on)")
+    return stratified([group_key(pr) for pr in ds.prs], holdout, seed)
+
+
+@dataclass
+class Ranking:
+    prob: Problem
+    null: Fit
+    singles: list[Fit]
+    cands: list[Fit]  # every fit, best BIC first
+    best: Fit  # the candidate the fitting runs choose (single, pair or triple)
+    c_hat: float
+    gof: float | None
+    proposals: dict[str, str]
+    phases: dict[str, tuple[float, float]]
+
+
+def _sig_head(prob: Problem, chans: list[str]) -> float:
+    return float(prob.sigma[chans.index("A.heading_rad")]) if "A.heading_rad" in chans else 1e-3
+
+
+def rank(ds: Dataset, sel: Selection, progress: Progress = None) -> Ranking:
+    """Step 2: fit and rank the hypotheses on the fitting runs."""
+    fit_i = list(sel.fit)
+    prob = Problem(ds.mode, [ds.items[i] for i in fit_i])
+    chans = ds.items[0].channels()
+    sig_head = _sig_head(prob, chans)
+    fprs = [ds.prs[i] for i in fit_i]
+    if ds.mode == "truth":
+        walk = floor_walk(prob, ds.robot.vehicle)
+        sig = np.array(prob.sigma, dtype=float)
+        k = walk.window_sigma.size
+        T = 3 * ds.robot.n_trucks
+        sig[:T] = np.maximum(sig[:T], walk.window_sigma[:T]) if k >= T else sig[:T]
+        prob.set_background(walk, sig)
+    null = evaluate(prob, "nominal", {}, {}, 0)
+    phases = phase_excess(prob.items, {}, prob.sigma) if ds.mode == "truth" else {}
+    proposals = hypotheses.propose(phases)
+    hyps = hypotheses.singles(ds.mode, ds.robot.vehicle)
+    if ds.mode == "returns" and ds.return_accuracy is None:
+        # without the measurement's accuracy the returns' spread is the noise: roughness then
+        # shows only through its mean, which shortens every turn like an Eb (its alias; the
+        # report lists it under "not identifiable")
+        hyps = [h for h in hyps if "roughness" not in h.families]
+    for fam in proposals:
+        hyps += hypotheses.other_laws(fam, ds.mode, ds.robot.vehicle)
+    trucks = truck_excess(prob.items, {}, prob.sigma) if ds.robot.n_trucks == 2 else []
+    scoped = None
+    if trucks and max(trucks) >= hypotheses.TRUCK_SHARE:
+        # the misfit lives on one truck: its own variants of the truck-scoped effects (the
+        # independent world puts an effect on one truck of a clapper or set)
+        scoped = "AB"[int(np.argmax(trucks))]
+        proposals[f"on truck {scoped}"] = (
+            f"{max(trucks):.0%} of the excess misfit lies in truck {scoped}'s channels"
+        )
+        hyps += [v for v in (hypotheses.on_truck(h, scoped) for h in list(hyps)) if v is not None]
+    singles = []
+    for h in hyps:
+        if progress:
+            progress(f"fitting {h.name}")
+        singles.append(fit_hypothesis(h, prob, fprs, sig_head))
+    singles = [f for f in singles if _real(f)]
+    singles.sort(key=lambda f: f.bic)
+    cands = list(singles)
+    gof = prob.gof_z({})
+    best = singles[0]
+    gap = null.bic - best.bic >= DBIC_SIGNIFICANT or (gof is not None and gof >= Z_GAP)
+    # pairs, unless the best single already leaves nothing but background on the fitting runs'
+    # tracks (truth mode): most robots have one effect, and ten pair fits cost more than the rest
+    if gap and not (ds.mode == "truth" and _track_ratio(best, prob, ds, sel) <= R_WITHIN):
+        cands += _pairs(singles, prob, fprs, sig_head, progress)
+    cands.sort(key=lambda f: f.bic)
+    c_hat = max(1.0, best.chi / max(prob.e0 - best.k, 1))
+    pair = next((f for f in cands if f.hyp is not None and len(f.hyp.families) == 2), None)
+    if pair is not None and _more(best, pair, prob, ds, sel):
+        best = pair
+        third = _third(best, singles, prob, fprs, sig_head, progress)
+        cands += third
+        cands.sort(key=lambda f: f.bic)
+        tri = next((f for f in third if f.bic < best.bic), None)
+        if tri is not None and _more(best, tri, prob, ds, sel):
+            best = tri
+    best = _floor_or_scale(best, prob, ds.robot.vehicle)
+    return Ranking(prob, null, singles, cands, best, c_hat, gof, proposals, phases)
+
+
+FLOOR_RATIO = 2.0
+
+
+def _floor_or_scale(best: Fit, prob: Problem, vehicle: str) -> Fit:
+    """An Es that the floor's own walk accounts for is the floor. Roughness shortens every
+    wheel's travel on average (an Es) and walks it (the measured background); its law ties the
+    two. When the best candidate holds an Es whose shortening is within a factor FLOOR_RATIO of
+    what grains walking as much as the measured floor would give, and the walk is measured at
+    all, the effect is named roughness (same parameters: the Es is its mean). The roughness
+    hypothesis itself, its height set by the walk, loses such ties by a few tens of BIC where the
+    walk is estimated a little low."""
+    if best.hyp is None or "es" not in best.hyp.families or "roughness" in best.hyp.families:
+        return best
+    if prob.walk is None or not prob.walk.q_wheel_ci or prob.walk.q_wheel_ci[0][0] <= 0:
+        return best
+    from .model import rough_moments
+
+    h = prob.rough_from_walk()
+    if h <= 0:
+        return best
+    m1, _ = rough_moments(prob.items[0].pr.R[0], h)
+    predicted = m1 / 20.0  # catalog spacing
+    es = best.params.get("es.value", 1.0)
+    seen = 1.0 - 1.0 / es
+    if predicted <= 0 or not (1.0 / FLOOR_RATIO <= seen / predicted <= FLOOR_RATIO):
+        return best
+    rough = next(x for x in hypotheses.singles(prob.mode, vehicle) if x.name == "roughness")
+    laws = tuple(law for law in best.hyp.laws if law.family != "es") + rough.laws
+    return Fit(
+        best.name, best.params, best.stderr, best.dev, best.chi, best.n, best.k, best.bumps,
+        hypotheses.Hypothesis(laws),
+    )  # fmt: skip
+
+
+TRACK_GAIN = 1.5  # a further member must cut the fitting runs' track misfit by this factor ...
+
+
+def _more(base: Fit, more: Fit, prob: Problem, ds: Dataset, sel: Selection) -> bool:
+    """Whether `more` (one more effect) earns its place over `base` on the fitting runs.
+
+    By quasi-BIC (deviances over base's overdispersion c = chi^2 / (n - k) >= 1; Burnham &
+    Anderson's QAIC with BIC's penalty): a misfit the base leaves because its law is only
+    approximately the truth's is not evidence for another effect. In truth mode also by the
+    fitting runs' tracks: windows weigh a drift over a whole run like one window's worth, so
+    where the truth's noise is large per window (a real motion capture) an Eb or a scrub that
+    bends every arc barely moves the windows' evidence; the accumulated position and heading
+    error in units of the background (heldout.py, on the fitting runs) shows it. `more` must
+    then have the lower BIC, leave the base's track misfit above R_WITHIN, and cut it by
+    TRACK_GAIN."""
+    c = max(1.0, base.chi / max(prob.e0 - base.k, 1))
+    if base.qbic(c) - more.qbic(c) >= DBIC_PAIR:
+        return True
+    if ds.mode != "truth" or more.bic >= base.bic:
+        return False
+    r_base = _track_ratio(base, prob, ds, sel)
+    if r_base <= R_WITHIN:
+        return False
+    return _track_ratio(more, prob, ds, sel) * TRACK_GAIN <= r_base
+
+
+def _track_ratio(f: Fit, prob: Problem, ds: Dataset, sel: Selection) -> float:
+    """The accumulated misfit of the fitting runs under f, in units of the background."""
+    return evaluate_heldout(
+        ds.items, ds.prs, list(sel.fit), f, prob.sigma, prob.walk or Background("truth"), boot=0
+    ).ratio_after
+
+
+PRELIM = ("ed.value", "eb.value", "es.value", "scrub.k")
+
+
+def floor_walk(prob: Problem, vehicle: str) -> Background:
+    """The floor's walk (background.measure) under a preliminary fit of the kinematic effects
+    (Ed, Eb, Es, scrub: cheap, always well posed), so that their systematic misfit, repeated at
+    every turn, is not taken for a walk."""
+    keys = [k for k in PRELIM if k.split(".")[0] in catalog.hypotheses(prob.mode, vehicle)]
+    P, _ = fit_params(prob, keys)
+    return measure(prob.items, prob.sigma, prob.mode, P)
+
+
+ROUGH_MIN_MM = 0.05  # a roughness fitted below this is no floor at all
+
+
+def _real(f: Fit) -> bool:
+    """A roughness fitted to (next to) zero height is the nominal noise without the measured
+    walk, not a floor: as a member it would win a pair for the walk's parameter alone (the
+    blind check's slip came out roughness+slip at 0.0 mm)."""
+    return "roughness" not in f.hyp.families or (
+        f.params.get("roughness.max_height_mm", 0.0) >= ROUGH_MIN_MM
+    )
+
+
+def _warm(fits: list[Fit], names: set[str]) -> dict:
+    warm = {}
+    for f in fits:
+        if f.name in names:
+            warm.update(f.model_params())
+    return warm
+
+
+def _pairs(singles, prob, fprs, sig_head, progress) -> list[Fit]:
+    """Pairs of the top singles (one law per family), and roughness with each of them."""
+    top: list[Fit] = []
+    for f in singles:
+        if f.hyp.families[0] in ABSORBERS or any(t.hyp.families == f.hyp.families for t in top):
+            continue
+        top.append(f)
+        if len(top) == N_PAIR_BASE:
+            break
+    detected: dict[str, list] = {}
+
+    def bumps_for(other: Fit) -> list | None:
+        """Floor bumps for a pair with bumps. Next to a partner that only drifts (ed) or moves
+        nothing the step detector sees, the single's serve; a partner that changes a spot turn's
+        angle (eb, es, slip, roughness's mean) puts heading steps at every turn, which the
+        nominal model's detector took for bumps (nine per UMBmark run under Eb 1.013): those
+        pairs share one detection under the best single other than bumps and roughness."""
+        if other.hyp.families[0] in BUMPS_REUSE_WITH:
+            return next((f.bumps for f in singles if f.name == "bumps"), None)
+        if "best" not in detected:
+            others = [f for f in singles if not f.hyp.has_bumps]
+            ref = next((f for f in others if f.hyp.families[0] not in ABSORBERS), others[0])
+            detected["best"] = cluster_bumps(detect_bumps(prob.items, ref.model_params(), sig_head))
+        return detected["best"]
+
+    pairs = list(itertools.combinations(top, 2))
+    absorbers = [f for f in singles if f.hyp.families[0] in ABSORBERS]
+    pairs += [(a, b) for a in absorbers for b in top]
+    out = []
+    for a, b in pairs:
+        h = a.hyp + b.hyp
+        if progress:
+            progress(f"fitting {h.name}")
+        fb = None
+        if h.has_bumps:
+            other = a if not a.hyp.has_bumps else b
+            fb = bumps_for(other)
+        out.append(fit_hypothesis(h, prob, fprs, sig_head, fb, _warm(singles, {a.name, b.name})))
+    return [f for f in out if _real(f)]
+
+
+def _third(pair: Fit, singles, prob, fprs, sig_head, progress) -> list[Fit]:
+    """A third member for an accepted pair (the kinematic calibration of a real robot is often
+    three: Ed, Eb and a scrub), from the best kinematic singles of other families."""
+    out = []
+    n = 0
+    for f in singles:
+        if set(f.hyp.families) & set(pair.hyp.families) or f.hyp.families[0] not in THIRDS:
+            continue
+        h = pair.hyp + f.hyp
+        if progress:
+            progress(f"fitting {h.name}")
+        warm = dict(pair.model_params())
+        warm.update(f.model_params())
+        fb = pair.bumps if pair.hyp.has_bumps else None
+        out.append(fit_hypothesis(h, prob, fprs, sig_head, fb, warm))
+        n += 1
+        if n == N_THIRD:
+            break
+    return [f for f in out if _real(f)]
+
+
+@dataclass
+class Judgement:
+    verdict: str  # the named effect(s), "no significant gap" or "unexplained"
+    reason: str
+    background: Background
+    held: HeldOut
+    dbic: float
+
+
+def judge(ds: Dataset, sel: Selection, rk: Ranking) -> Judgement:
+    """Step 3: background under the best candidate, held-out gap, verdict."""
+    items, fit_items = ds.items, rk.prob.items
+    if ds.mode == "truth" and ds.instrument is not None:
+        apply(rk.best, ds.prs)
+        ds.instrument = instrument.under(ds.instrument, ds.prs, rk.best.model_params())
+        clear_bumps(ds.prs)
+        items = [TruthMode(pr, ds.robot, ds.instrument) for pr in ds.prs]
+        fit_items = [items[i] for i in sel.fit]
+        ds.items = items
+    fprs = [ds.prs[i] for i in sel.fit]
+    apply(rk.best, fprs)
+    bg = measure(fit_items, rk.prob.sigma, ds.mode, rk.best.model_params())
+    clear_bumps(fprs)
+    held = evaluate_heldout(items, ds.prs, list(sel.held), rk.best, rk.prob.sigma, bg)
+    dbic = rk.null.bic - rk.best.bic
+    verdict, reason = decide(held, dbic, rk.best.label)
+    return Judgement(verdict, reason, bg, held, dbic)
+
+
+LATENCY_MOVE_S = 0.005
+
+
+def _relatency(ds: Dataset, sel: Selection, rk: Ranking) -> bool:
+    """Truth mode: is the best candidate's slip the truth's clock? A latency and slip both leave
+    the heading and travel behind where the speed changes (a latency by L dv, slip by k v dv), so
+    the ranking, which keeps a latency only when it is at least half a tick, can give slip a
+    shift it should not have (the independent world's truth runs ~25 ms late on 100 ms ticks).
+    The candidate without its slip is fitted again with each run's latency estimated under it
+    (instrument.under); if that explains the fitting runs better, latency counted as one
+    parameter per run, the items are rebuilt with it and the ranking runs again (True)."""
+    best = rk.best
+    if ds.mode != "truth" or ds.instrument is None or best.hyp is None:
+        return False
+    if "slip" not in best.hyp.families:
+        return False
+    rest = [law for law in best.hyp.laws if law.family != "slip"]
+    P0 = {k: v for k, v in best.model_params().items() if not k.startswith("slip")}
+    inst = instrument.under(ds.instrument, ds.prs, P0)
+    moved = [
+        k
+        for k, v in ds.instrument.latency_s.items()
+        if abs(inst.latency_s.get(k, 0.0) - v) > LATENCY_MOVE_S
+    ]
+    if not moved:
+        return False
+    items = [TruthMode(pr, ds.robot, inst) for pr in ds.prs]
+    prob = Problem("truth", [items[i] for i in sel.fit], rk.prob.sigma)
+    prob.set_background(rk.prob.walk, rk.prob.sigma)
+    fprs = [ds.prs[i] for i in sel.fit]
+    if rest:
+        alt = fit_hypothesis(
+            hypotheses.Hypothesis(tuple(rest)),
+            prob,
+            fprs,
+            _sig_head(prob, items[0].channels()),
+            warm=P0,
+        )
     else:
-        P0 = {}
-        if keys:
-            P0 = dict(base.params) if base is not None else fit_params(prob, keys)[0]
-        fb = cluster_bumps(detect_bumps(prob.items, P0, sig_head))
-    place_bumps(prs, fb, own=True)
-    P, se = fit_params(prob, keys, {}) if keys else ({}, {})
-    h = float(np.median([b["h"] for b in fb])) if fb else 0.0
-    P = dict(P)
-    P["bumps.height_mm"] = h
-    se["bumps.height_mm"] = float(np.std([b["h"] for b in fb]) / math.sqrt(len(fb))) if fb else 0.0
-    f = evaluate(prob, name, P, se, len(keys) + 1 + 2 * len(fb), fb)
-    clear_bumps(prs)
-    return f
+        alt = evaluate(prob, "nominal", {}, {}, 0)
+    n_lat = sum(1 for pr in fprs if abs(inst.latency_s.get(pr.run.name, 0.0)) > 0)
+    if alt.bic + n_lat * math.log(max(alt.n, 2)) + DBIC_SIGNIFICANT >= best.bic:
+        return False
+    if not all(instrument.one_clock(ds.prs, inst.latency_s).values()):
+        return False
+    ds.instrument = inst
+    ds.items = items
+    return True
 
 
-HELDOUT_BUMP_MIN_RUNS = 2
-# partners under which the single's floor bumps are reused (diagnose: bumps_for)
-BUMPS_REUSE_WITH = {"ed", "skid", "rotary_bias", "link_bias"}
-# roughness inflates the variance: it can come first among the singles by absorbing another
-# effect's systematic misfit, so it is paired with the best others instead of taking their place
-ABSORBERS = {"roughness"}
-N_PAIR_BASE = 4
-
-
-def apply(f: Fit, prs: list, min_runs: int = 1) -> dict:
-    """Put the fit's effect on runs; `min_runs`: place only floor bumps seen in that many fitting
-    runs. Held-out runs use 2: a bump found in one run only may belong to that run (rect-7x4 lays
-    its bumps under alternating wheels from run to run), and predicting it where it is not adds
-    a heading step the held-out run never had; a bump two runs of the path agree on is a floor
-    feature."""
-    clear_bumps(prs)
-    if f.bumps:
-        place_bumps(prs, [b for b in f.bumps if len(b.get("runs", [])) >= min_runs])
-    return {k: v for k, v in f.params.items() if not k.startswith("bumps.")}
+def _slip_not_latency(ds: Dataset, sel: Selection, rk: Ranking) -> bool:
+    """The converse of `_relatency`: runs given a latency, and a best candidate without slip -
+    is the latency the robot's slip? The candidate plus catalog slip is fitted on the items
+    without latency; if that explains the fitting runs better (each latency one parameter),
+    the latencies go and the ranking runs again (True). The blind check's simulator has no
+    latency, but its slip on rect-7x4's faster starts read as 25 ms, and scrub took the rest."""
+    best = rk.best
+    if ds.mode != "truth" or ds.instrument is None or best.hyp is None:
+        return False
+    fprs = [ds.prs[i] for i in sel.fit]
+    lat = [pr for pr in fprs if abs(ds.instrument.latency_s.get(pr.run.name, 0.0)) > 0]
+    if not lat or "slip" in best.hyp.families:
+        return False
+    inst = Instrument(
+        list(ds.instrument.lever_mm), list(ds.instrument.lever_se_mm),
+        {k: 0.0 for k in ds.instrument.latency_s},
+    )  # fmt: skip
+    items = [TruthMode(pr, ds.robot, inst) for pr in ds.prs]
+    prob = Problem("truth", [items[i] for i in sel.fit], rk.prob.sigma)
+    prob.set_background(rk.prob.walk, rk.prob.sigma)
+    slip = next(h for h in hypotheses.singles("truth", ds.robot.vehicle) if h.name == "slip")
+    alt = fit_hypothesis(
+        best.hyp + slip, prob, fprs, _sig_head(prob, items[0].channels()), warm=best.model_params()
+    )
+    if alt.bic >= best.bic - len(lat) * math.log(max(best.n, 2)):
+        return False
+    ds.instrument = inst
+    ds.items = items
+    return True
 
 
 def diagnose(
-    real: str | Path,
+    real,
     robot_path: str | Path,
     holdout: float = 0.5,
     seed: int = 1,
     mode: str | None = None,
-    progress=None,
+    progress: Progress = None,
     return_accuracy: tuple[float, float] | None = None,
-) -> dict:
-    """Diagnose the runs in `real` (module doc, README). `return_accuracy`: (mm, deg) of the
-    return measurement, for returns mode; without it the returns' spread is taken as noise."""
+    fit: list[str] | None = None,
+    judge_runs: list[str] | None = None,
+    groups: list[str] | None = None,
+) -> Report:
+    """Diagnose the runs in `real` (a folder or a list of folders; module doc)."""
     t0 = time.perf_counter()
-    robot = read_robot(robot_path)
-    real = Path(real)
-    runs = discover(real, robot)
-    if len(runs) < 2:
-        raise GapInputError(real, "needs at least two runs (one to fit, one to hold out)")
-    mode = pick_mode(runs, robot.vehicle, mode, real)
-    prs = [prepare(r, robot) for r in runs]
-    M = MODES[mode]
-    try:
-        extra = ()
-        if mode == "returns" and return_accuracy is not None:
-            mm, deg = return_accuracy
-            extra = ((mm, mm, math.radians(deg)),)
-        items = [M(pr, robot, *extra) for pr in prs]
-    except ValueError as e:
-        raise GapInputError(real, f"mode {mode}: {e}") from None
-    assign_paths(prs)
-    fit_i, held_i = split(runs, holdout, seed, [group_key(pr) for pr in prs])
-    if not held_i:
-        held_i = fit_i
-    prob = Problem(mode, [items[i] for i in fit_i])
-    chans = items[0].channels()
-    sig_head = float(prob.sigma[chans.index("A.heading_rad")]) if "A.heading_rad" in chans else 1e-3
-    fprs = [prs[i] for i in fit_i]
-    null = evaluate(prob, "nominal", {}, {}, 0)
-    singles = []
-    for h in applicable(mode, robot.vehicle):
+    ds = load(real, robot_path, mode, return_accuracy, groups)
+    sel = select_runs(ds, holdout, seed, fit, judge_runs)
+    rk = rank(ds, sel, progress)
+    if _relatency(ds, sel, rk) or _slip_not_latency(ds, sel, rk):
         if progress:
-            progress(f"fitting {h}")
-        singles.append(fit_hypothesis(h, prob, fprs, robot.vehicle, sig_head))
-    singles.sort(key=lambda f: f.bic)
-    best = singles[0]
-    cands = list(singles)
-    # pairs from the top four singles (and roughness with each of them) whenever there is a gap
-    # at all: a weak second effect (ed under a rotary bias whose linkage misfit dominates) leaves
-    # the best single "explaining" most of the misfit yet still costs BIC; the pair must pay for
-    # its parameters (DBIC_PAIR)
-    gof = prob.gof_z({})
-    if null.bic - best.bic >= DBIC_SIGNIFICANT or (gof is not None and gof >= Z_GAP):
-        top = [f.name for f in singles if f.name not in ABSORBERS][:N_PAIR_BASE]
-        detected: dict[str, list] = {}
-
-        def bumps_for(pair: str) -> list | None:
-            """Floor bumps for a pair with bumps. Next to a partner that only drifts (ed) or
-            moves nothing the step detector sees, the single's serve (found under the nominal
-            model). A partner that changes a spot turn's angle (eb, es, slip, roughness's mean)
-            puts heading steps at every turn, which the nominal model's detector took for
-            bumps (nine per UMBmark run under Eb 1.013, the real ones missed): those pairs
-            share one detection under the best single other than bumps and roughness."""
-            partner = next(x for x in pair.split("+") if x != "bumps")
-            if partner in BUMPS_REUSE_WITH:
-                return next((f.bumps for f in singles if f.name == "bumps"), None)
-            if "best" not in detected:
-                others = [f for f in singles if f.name != "bumps"]
-                ref = next((f for f in others if f.name not in ABSORBERS), others[0])
-                P0 = {k: v for k, v in ref.params.items() if not k.startswith("bumps.")}
-                detected["best"] = cluster_bumps(detect_bumps(prob.items, P0, sig_head))
-            return detected["best"]
-
-        pairs = list(itertools.combinations(top, 2))
-        pairs += [(a, b) for a in ABSORBERS for b in top if any(f.name == a for f in singles)]
-        for a, b in pairs:
-            name = "+".join(sorted((a, b), key=lambda x: x == "bumps"))
-            if progress:
-                progress(f"fitting {name}")
-            basef = next((f for f in singles if f.name == name.split("+")[0]), None)
-            fb = bumps_for(name) if "bumps" in name.split("+") else None
-            warm = {}
-            for f in singles:
-                if f.name in (a, b):
-                    warm.update(f.params)
-            cands.append(fit_hypothesis(name, prob, fprs, robot.vehicle, sig_head, basef, fb, warm))
-    cands.sort(key=lambda f: f.bic)
-    best_single = singles[0]
-    best_pair = next((f for f in cands if "+" in f.name), None)
-    verdict_fit = best_single
-    # a pair must beat the best single by DBIC_PAIR in quasi-BIC: deviances divided by the best
-    # single's overdispersion c = chi^2 / (n - k) (>= 1; Burnham & Anderson's QAIC, with BIC's
-    # penalty). A misfit the best single leaves because its law is only approximately the truth's
-    # (e.g. slip's lag) is not evidence for a second effect.
-    c_hat = max(1.0, best_single.chi / max(prob.e0 - best_single.k, 1))
-    if best_pair is not None and qbic(best_single, c_hat) - qbic(best_pair, c_hat) >= DBIC_PAIR:
-        verdict_fit = best_pair
-    dbic = null.bic - verdict_fit.bic
-    share = explained(null, verdict_fit, prob.e0)
-    # a gap is there when a hypothesis earns it (Delta BIC) or when the nominal model misfits the
-    # data beyond the measured noise whether or not anything explains it (truth mode): a bounded
-    # hysteresis (gear backlash) no catalog effect fits is "unexplained", not "no gap"
-    if dbic < DBIC_SIGNIFICANT and (gof is None or gof < Z_GAP):
-        verdict = "no significant gap"
-    elif share < EXPLAINED_MIN:
-        verdict = "unexplained"
-    else:
-        verdict = verdict_fit.name
-    runner = next((f for f in cands if f.name != verdict_fit.name), None)
-
-    # how far: held-out runs, before and after. Two gap metrics (README "How far"):
-    # - the systematic gap: RMS of the held-out residuals in units of the noise sigma, minus the
-    #   noise-only level (excess over the noise floor), floored at its own resolution; the shrink
-    #   and its CI are on this one;
-    # - the physical one in mm (truth: RMS position error of truck A; ...), for people.
-    hprs = [prs[i] for i in held_i]
-    P_after = (
-        apply(verdict_fit, hprs, HELDOUT_BUMP_MIN_RUNS)
-        if verdict not in ("no significant gap",)
-        else {}
+            progress("latency and slip told apart: ranking again")
+        rk = rank(ds, sel, progress)
+    jd = judge(ds, sel, rk)
+    fit_items = [ds.items[i] for i in sel.fit]
+    fit_prs = [ds.prs[i] for i in sel.fit]
+    if progress:
+        progress("parameters per group")
+    stab_fit = rk.best if rk.best.hyp is not None else None
+    group_fits, findings = stability(
+        fit_items, fit_prs, ds.mode, rk.prob.sigma, stab_fit, ds.groups
     )
-    after_mm = np.array([items[i].gap(P_after) for i in held_i])
-    z2_after = [_z2(items[i], P_after, prob.sigma) for i in held_i]
-    clear_bumps(hprs)
-    before_mm = np.array([items[i].gap({}) for i in held_i])
-    z2_before = [_z2(items[i], {}, prob.sigma) for i in held_i]
-    zb = np.array([x[0] for x in z2_before])
-    za = np.array([x[0] for x in z2_after])
-    nn = np.array([x[1] for x in z2_before])
-    rng = np.random.default_rng(seed)
-    bs = []
-    for _ in range(1000):
-        s = rng.integers(0, len(held_i), len(held_i))
-        bs.append(_sysgap(zb[s], nn[s]) / _sysgap(za[s], nn[s]))
-    gap_b, gap_a = _sysgap(zb, nn), _sysgap(za, nn)
-    shrink = float(gap_b / gap_a)
-    ci = [float(np.percentile(bs, 2.5)), float(np.percentile(bs, 97.5))]
-    before, after = before_mm, after_mm
-    shrink_mm = float(before.sum() / max(after.sum(), 1e-9))
-
-    where = where_analysis(
-        items,
-        prs,
-        verdict_fit if verdict not in ("no significant gap",) else None,
-        chans,
-        prob.sigma,
-    )
-    unident = [{"what": k, "why": v} for k, v in UNIDENTIFIABLE[mode].items()]
-    unident += [{"what": k, "why": v} for k, v in ALWAYS_UNIDENTIFIABLE.items()]
-    for k, se in verdict_fit.stderr.items():
-        v = verdict_fit.params.get(k, 0.0)
-        lo, _hi = (0.8, 1.25) if k.endswith(".value") else (None, None)
-        ref = abs(v - 1.0) if lo is not None else abs(v)
-        if se and math.isfinite(se) and ref > 0 and se > 0.5 * ref:
-            unident.append(
-                {"what": k, "why": f"fitted {v:.4g} +- {se:.2g}: not fixed by these runs"}
-            )
-    if mode == "returns" and return_accuracy is None:
-        unident.append(
-            {
-                "what": "roughness vs eb",
-                "why": "without the return measurement's accuracy (--return-accuracy) the "
-                "returns' spread is the noise, and roughness's mean shortens every turn like an Eb",
-            }
-        )
-    if mode == "returns":
-        unident.append(
-            {
-                "what": "ed vs slip vs encoder bias",
-                "why": "return errors of one path excite them alike unless the paths differ",
-            }
-        )
-    report = {
-        "tool": "odo-gap diagnose",
-        "real": str(real),
-        "robot": str(robot_path),
-        "mode": mode,
-        "vehicle": robot.vehicle,
-        "runs": [r.name for r in runs],
-        "fit_runs": [runs[i].name for i in fit_i],
-        "heldout_runs": [runs[i].name for i in held_i],
-        "return_accuracy": list(return_accuracy) if return_accuracy else None,
-        "evidence_measure": "BIC = -2 ln L (Gaussian, per-channel sigma from the data) + k ln n",
-        "noise_sigma": dict(zip(chans, map(float, prob.sigma), strict=False)),
-        "thresholds": {
-            "dbic_significant": DBIC_SIGNIFICANT,
-            "explained_min": EXPLAINED_MIN,
-            "dbic_pair": DBIC_PAIR,
-            "z_gap": Z_GAP,
-        },
-        "nominal_fit_z": gof,
-        "verdict": {
-            "effect": verdict,
-            "best_candidate": verdict_fit.name,
-            "params": _clean(verdict_fit.params),
-            "stderr": _clean(verdict_fit.stderr),
-            "evidence": {
-                "bic": verdict_fit.bic,
-                "dbic_vs_nominal": dbic,
-                "explained_share": share,
-                "k": verdict_fit.k,
-                "n": verdict_fit.n,
-            },
-            "bumps": verdict_fit.bumps,
-        },
-        "runner_up": None
-        if runner is None
-        else {
-            "effect": runner.name,
-            "params": _clean(runner.params),
-            "bic": runner.bic,
-            "margin_dbic": runner.bic - verdict_fit.bic,
-        },
-        "ranking": [
-            {
-                "effect": f.name,
-                "bic": f.bic,
-                "dbic_vs_nominal": null.bic - f.bic,
-                "explained_share": explained(null, f, prob.e0),
-                "k": f.k,
-                "params": _clean(f.params),
-            }
-            for f in [*cands, null]
-        ],
-        "where": where,
-        "gap_metric_mm": {
-            "truth": "RMS position error of truck A along the run (mm)",
-            "returns": "return position error (mm)",
-            "linkage": "RMS linkage prediction error over 1 s horizons (mm)",
-        }[mode],
-        "gap_definition": "systematic gap: sqrt(max(mean z^2 - 1, 2 sqrt(2/n))) over the held-out "
-        "runs' standardised residuals z (truth: accumulated position error of each truck in units "
-        "of the truth's position noise, and linkage readings; returns, linkage: the mode's "
-        "residuals; sigma from the fitting runs): the RMS misfit in excess of the noise-only "
-        "level, floored at twice that level's standard error (no shrink below it is measurable); "
-        "shrink = before / after",
-        "gap_before": gap_b,
-        "gap_after_heldout": gap_a,
-        "shrink": shrink,
-        "shrink_ci": ci,
-        "gap_before_mm": float(before.mean()),
-        "gap_after_heldout_mm": float(after.mean()),
-        "gap_before_runs_mm": before.tolist(),
-        "gap_after_runs_mm": after.tolist(),
-        "shrink_mm": shrink_mm,
-        "unidentifiable": unident,
-        "elapsed_s": time.perf_counter() - t0,
-    }
-    report["_plot"] = {"items": items, "prs": prs, "fit": verdict_fit, "cands": cands, "null": null}
-    return report
-
-
-def _z2(item, P: dict, sigma: np.ndarray) -> tuple[float, int]:
-    """Sum of squared standardised residuals of one run, and their count."""
-    r = item.sys_z(P, sigma) if hasattr(item, "sys_z") else item.residuals(P) / sigma
-    return float(np.sum(r * r)), int(r.size)
-
-
-def _sysgap(z2: np.ndarray, n: np.ndarray) -> float:
-    """Systematic gap of pooled runs: RMS misfit above the noise-only level (1 per scalar),
-    floored at twice the standard error of mean z^2 under noise alone, sqrt(2 / n)."""
-    N = max(float(np.sum(n)), 1.0)
-    return float(math.sqrt(max(float(np.sum(z2)) / N - 1.0, 2.0 * math.sqrt(2.0 / N))))
-
-
-def _clean(d: dict) -> dict:
-    return {k: float(v) for k, v in d.items()}
-
-
-def classify(pr, tick_s: float) -> np.ndarray:
-    """Per tick: stationary, turn (on the spot), straight, arc, accelerating."""
-    ds = pr.ds[:, 0, :]
-    v = 0.5 * (ds[:, 0] + ds[:, 1]) / pr.dt
-    om = (ds[:, 1] - ds[:, 0]) / pr.b[0] / pr.dt
-    acc = np.abs(np.gradient(v, pr.t[1:]))
-    lab = np.full(v.size, "straight", dtype=object)
-    lab[np.abs(om) * 0.5 * pr.b[0] > 0.2 * np.maximum(np.abs(v), 1e-9)] = "arc"
-    lab[(np.abs(v) < 5.0) & (np.abs(om) > 0.02)] = "turn"
-    lab[(acc > 50.0) & (lab == "straight")] = "acceleration"
-    lab[(np.abs(v) < 1.0) & (np.abs(om) < 0.005)] = "stationary"
-    return lab
-
-
-def where_analysis(items, prs, f: Fit | None, chans, sigma) -> list[dict]:
-    out = []
-    for it, pr in zip(items, prs, strict=False):
-        r = it.residuals({})
-        entry = {"run": pr.run.name, "gap": it.gap({})}
-        w = r / sigma
-        share = (w**2).sum(axis=0)
-        tot = share.sum() or 1.0
-        entry["channels"] = {c: float(s / tot) for c, s in zip(chans, share, strict=False)}
-        if isinstance(it, TruthMode):
-            lab = classify(pr, pr.dt.mean())
-            tmid = pr.t[1:]
-            wl = lab[np.clip(np.searchsorted(tmid, it.tt[it.i]), 0, lab.size - 1)]
-            segs = {}
-            for s in np.unique(wl):
-                segs[str(s)] = float((w[wl == s] ** 2).sum() / tot)
-            entry["segments"] = segs
-            # legs: motion between stops
-            moving = lab != "stationary"
-            edges = np.flatnonzero(np.diff(moving.astype(int)))
-            entry["n_legs"] = int((edges.size + 1) // 2)
-            tt, err = it.error_track({})
-            dist = np.interp(tt, pr.t, pr.S[:, 0].mean(axis=1))
-            e = np.hypot(err[:, 0], err[:, 1])
-            entry["gap_end_mm"] = float(e[-1])
-            entry["gap_max_mm"] = float(e.max())
-            entry["gap_max_at_mm"] = float(dist[int(np.argmax(e))])
-        if f is not None and f.bumps:
-            from .fit import group_key
-
-            g = group_key(pr)
-            entry["events"] = [
-                {
-                    "kind": "bump",
-                    "truck": "AB"[b["truck"]],
-                    "wheel": ("left", "right")[b["wheel"]],
-                    "at_wheel_travel_mm": b["s0"],
-                    "height_mm": b["h"],
-                    "x_mm": b["x_mm"],
-                    "y_mm": b["y_mm"],
-                }
-                for b in f.bumps
-                if b["group"] == g
-            ]
-        out.append(entry)
-    return out
-
-
-def write_report(rep: dict, out: str | Path) -> None:
-    """Everything into OUT.tmp.<pid>, then renamed into place: never a partial report."""
-    from .plots import plot_report
-
-    out = Path(out)
-    tmp = out.with_name(out.name + f".tmp.{os.getpid()}")
-    if tmp.exists():
-        shutil.rmtree(tmp)
-    tmp.mkdir(parents=True)
-    try:
-        extra = rep.pop("_plot", None)
-        (tmp / "report.json").write_text(json.dumps(rep, indent=2) + "\n")
-        (tmp / "report.md").write_text(markdown(rep))
-        if extra is not None:
-            plot_report(rep, extra, tmp)
-        if out.exists():
-            old = out.with_name(out.name + f".old.{os.getpid()}")
-            out.rename(old)
-            tmp.rename(out)
-            shutil.rmtree(old)
-        else:
-            tmp.rename(out)
-    except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
-        raise
-
-
-def markdown(rep: dict) -> str:
-    v = rep["verdict"]
-    L = [
-        f"# odo-gap diagnosis: {rep['real']}",
-        "",
-        f"Mode **{rep['mode']}** ({rep['vehicle']}), {len(rep['runs'])} runs: fitted on "
-        f"{len(rep['fit_runs'])}, judged on {len(rep['heldout_runs'])} held out.",
-        "",
-        f"## Verdict: **{v['effect']}**",
-        "",
-    ]
-    if v["effect"] != v["best_candidate"]:
-        L.append(
-            f"Best candidate {v['best_candidate']} explains {v['evidence']['explained_share']:.0%} "
-            f"of the excess misfit (needs {rep['thresholds']['explained_min']:.0%})."
-        )
-    L += ["| parameter | fitted | +- |", "|---|---|---|"]
-    for k, x in v["params"].items():
-        L.append(f"| {k} | {x:.6g} | {v['stderr'].get(k, float('nan')):.2g} |")
-    e = v["evidence"]
-    L += [
-        "",
-        f"Evidence ({rep['evidence_measure']}): Delta BIC vs nominal {e['dbic_vs_nominal']:.1f}, "
-        f"explained share {e['explained_share']:.3f}, k = {e['k']}, n = {e['n']}.",
-    ]
-    if rep["runner_up"]:
-        r = rep["runner_up"]
-        L.append(f"Runner-up: {r['effect']} (BIC margin {r['margin_dbic']:.1f}).")
-    L += [
-        "",
-        "## How far it shrinks (held-out runs)",
-        "",
-        "Systematic gap (RMS misfit in excess of the noise-only level, in noise sigmas; "
-        f"report.json gap_definition): before {rep['gap_before']:.2f}, after "
-        f"{rep['gap_after_heldout']:.2f}: shrink x{rep['shrink']:.1f} "
-        f"(95% CI {rep['shrink_ci'][0]:.1f} - {rep['shrink_ci'][1]:.1f}).",
-        "",
-        f"In mm ({rep['gap_metric_mm']}): before {rep['gap_before_mm']:.2f}, after "
-        f"{rep['gap_after_heldout_mm']:.2f} (x{rep['shrink_mm']:.1f}).",
-        "",
-        "## Ranking",
-        "",
-        "| hypothesis | Delta BIC vs nominal | explained | k |",
-        "|---|---|---|---|",
-    ]
-    for r in rep["ranking"][:12]:
-        L.append(
-            f"| {r['effect']} | {r['dbic_vs_nominal']:.1f} | {r['explained_share']:.3f} "
-            f"| {r['k']} |"
-        )
-    L += ["", "## Where", ""]
-    for w in rep["where"]:
-        ch = max(w["channels"], key=w["channels"].get)
-        s = f"- {w['run']}: gap {w['gap']:.2f}; mostly in {ch} ({w['channels'][ch]:.0%})"
-        if "segments" in w:
-            sg = max(w["segments"], key=w["segments"].get)
-            s += f", during {sg} ({w['segments'][sg]:.0%}); end error {w['gap_end_mm']:.1f} mm"
-        if w.get("events"):
-            s += f"; {len(w['events'])} bump(s): " + ", ".join(
-                f"{x['wheel']} at {x['at_wheel_travel_mm']:.0f} mm "
-                f"({x['x_mm']:.0f}, {x['y_mm']:.0f})"
-                for x in w["events"][:5]
-            )
-        L.append(s)
-    L += ["", "## Not identifiable from these data", ""]
-    L += [f"- {u['what']}: {u['why']}" for u in rep["unidentifiable"]]
-    return "\n".join(L) + "\n"
+    chans = ds.items[0].channels()
+    named = jd.verdict not in ("no significant gap", "unexplained")
+    where = where_analysis(ds.items, ds.prs, rk.best if named else None, chans, rk.prob.sigma)
+    rep = Report.build(ds, sel, rk, jd, where, group_fits, findings)
+    rep.elapsed_s = time.perf_counter() - t0
+    rep.context = Context(ds.items, ds.prs, rk.best if named else None, list(sel.held), rk)
+    return rep

@@ -1,4 +1,4 @@
-"""Hypotheses, fits and evidence.
+"""Fits and evidence.
 
 Evidence is BIC: deviance -2 ln L of Gaussian residuals (per-channel noise sigma estimated once
 from the data: the truth's sample noise, the returns' spread or stated accuracy, the linkage
@@ -16,109 +16,127 @@ from functools import cached_property
 import numpy as np
 from scipy.optimize import least_squares
 
-from .model import Prepared, bump_dd, bump_excess
-from .simlib import catalog
+from .hypotheses import Hypothesis, bounds
+from .paths import group_key
 
-DBIC_SIGNIFICANT = 10.0  # best hypothesis vs nominal: below -> "no significant gap"
-EXPLAINED_MIN = 0.75  # share of the excess misfit a verdict must remove, else "unexplained"
-DBIC_PAIR = 10.0  # a pair must beat the best single by this much
+DBIC_SIGNIFICANT = 10.0  # best hypothesis vs nominal on the fitting runs (Kass & Raftery)
+DBIC_PAIR = 10.0  # a pair must beat the best single by this much (quasi-BIC)
 Z_GAP = 5.0  # nominal misfit above the noise-only chi^2, in its standard deviations: a gap
 
-# Free parameters per hypothesis (others stay at the catalog default). See README for why.
-FREE = {
-    "ed": ["value"],
-    "eb": ["value"],
-    "es": ["value"],
-    "roughness": ["max_height_mm"],
-    "slip": ["k_per_m_s2", "tau_s"],
-    "skid": ["k_s"],
-    "rotary_bias": ["alpha_deg", "beta_deg"],
-    "link_bias": ["const_mm", "ecc_mm"],
-}
-START = {"slip.k_per_m_s2": 0.05, "skid.k_s": 0.05, "roughness.max_height_mm": 0.5}
-UNIDENTIFIABLE = {
-    "returns": {
-        "es": "closed paths do not fix the overall scale (Es)",
-        "bumps": "return errors carry no positions of discrete events",
-        "skid": "a corner's outward skid turns no heading, and around a closed path the "
-        "corners' displacements cancel: k = 0.3 s moves these return poses by ~1 mm "
-        "(tests/python/test_gap_evidence.py)",
-        "rotary_bias": "needs linkage readings",
-        "link_bias": "needs linkage readings",
-    },
-    "truth": {},
-    "linkage": {"bumps": "not located from linkage readings alone (tested in truth mode)"},
-}
-ALWAYS_UNIDENTIFIABLE = {
-    "tire_compression": "kinematically an Ed plus an Es (off-centre load and mean load): aliased "
-    "with the pair ed+es, reported through them",
-    "count_loss": "lost counts leave no trace in the counts themselves at these speeds",
-}
 
-
-def applicable(mode: str, vehicle: str) -> list[str]:
-    h = ["ed", "eb", "es", "roughness", "slip", "skid"]
-    if mode == "truth":
-        h.append("bumps")
-    if vehicle != "labmate" and mode in ("truth", "linkage"):
-        h.append("rotary_bias")
-        if vehicle == "clapper":
-            h.append("link_bias")
-    return [x for x in h if x not in UNIDENTIFIABLE[mode]]
-
-
-def free_params(effect: str, vehicle: str) -> list[str]:
-    f = FREE.get(effect, [])
-    if effect == "rotary_bias" and vehicle == "set":
-        f = ["alpha_deg"]
-    return [f"{effect}.{p}" for p in f]
-
-
-# model-side nuisances that are not catalog parameters: (min, max, start)
-NUISANCE = {"slip.tau_s": (0.0005, 0.02, 0.004)}
-
-
-def bounds(key: str) -> tuple[float, float, float]:
-    if key in NUISANCE:
-        return NUISANCE[key]
-    e, p = key.split(".")
-    d = next(x for x in catalog()[e]["params"] if x["name"] == p)
-    return float(d["min"]), float(d["max"]), float(d["default"])
+def has_rough(P: dict) -> bool:
+    """A roughness on any truck (its law brings its own variance)."""
+    return any(k.startswith("roughness.max_height_mm") and v > 0 for k, v in P.items())
 
 
 @dataclass
 class Problem:
-    """The fitting runs of one mode: residual builders, noise, data count."""
+    """The fitting runs of one mode: residual builders, noise, data count.
+
+    `walk` (background.Background, truth mode): the floor's heading and travel random walk,
+    measured under a preliminary kinematic fit; its variance joins every window's for every
+    hypothesis except roughness, whose own law gives its variance (the walk is one measured
+    parameter, counted in k for every hypothesis). Without it a floor that walks makes every
+    window overdispersed,
+    and roughness won the ranking by soaking that up (the OptiOdom robot: 'roughness' first,
+    the kinematic effects behind it)."""
 
     mode: str
     items: list  # mode objects (one per run)
     sigma: np.ndarray = field(default=None)
+    walk: object = None
 
     def __post_init__(self) -> None:
         if self.sigma is None:
             self.sigma = estimate_sigma(self.items, self.mode)
 
+    def set_background(self, walk, sigma: np.ndarray | None = None) -> None:
+        """Put the measured walk (and a window-scale noise) into every window's variance."""
+        self.walk = walk
+        if sigma is not None:
+            self.sigma = sigma
+        self.__dict__.pop("e0", None)
+        self.__dict__.pop("_vcache", None)
+
     def resid(self, P: dict) -> np.ndarray:
         return np.vstack([it.residuals(P) for it in self.items])
 
+    def _var_parts(self, P: dict) -> list[np.ndarray]:
+        """Per item: (rows, channels) variance of each residual: sigma^2 plus the walk, or plus
+        roughness's own variance for roughness.
+
+        Truth windows share their end samples (MA(1) noise); they are still taken as
+        independent. The exact chain likelihood (banded Cholesky) was tried: it weighs a drift
+        over many windows by the whole run, and on the OptiOdom robot, whose motion-capture noise
+        is correlated and whose truth carries slow offsets after each start, it fitted Ed 1.066
+        (returns say 0.999): local increments are the robust choice for real truth."""
+        rough = has_rough(P)
+        cache = self.__dict__.setdefault("_vcache", {})
+        if rough not in cache:
+            parts = []
+            for it in self.items:
+                n = it.residuals({}).shape[0]
+                v = np.broadcast_to(self.sigma**2, (n, self.sigma.size)).copy()
+                if not rough and self.walk is not None:
+                    w = self.walk.window_var(it)
+                    if w is not None:
+                        v += w
+                parts.append(v)
+            cache[rough] = parts
+        out = []
+        for it, v in zip(self.items, cache[rough], strict=False):
+            e = it.extra_var(P)
+            out.append(v if e is None else v + e)
+        return out
+
+    def _whitened(self, P: dict) -> tuple[list[np.ndarray], float]:
+        """(standardised residuals per item, log det of their variance relative to sigma^2)."""
+        zs, logdet = [], 0.0
+        for it, v in zip(self.items, self._var_parts(P), strict=False):
+            zs.append(it.residuals(P) / np.sqrt(v))
+            logdet += float(np.log(v / self.sigma**2).sum())
+        return zs, logdet
+
+    def base_var(self) -> np.ndarray:
+        """(rows, channels) sigma^2 plus the walk's window variance (the diagonal)."""
+        return np.vstack(self._var_parts({}))
+
+    def rough_from_walk(self) -> float:
+        """The roughness height (catalog law, truck A's wheels) whose grains walk as much as the
+        floor measured on the fitting runs does while driving: roughness's hypothesis is that
+        floor, its mean shortening predicted, not a free height. Free, its variance (which grows
+        with each window's travel) absorbed any misfit that grows with speed - counts lost on a
+        sprint, a lever arm on fast arcs, slip on hard starts - at its bound, a scale error
+        cancelling its mean (the independent world's labmates came out es+roughness)."""
+        from .model import rough_moments
+
+        if self.walk is None or not self.walk.q_wheel or self.walk.q_wheel[0] <= 0:
+            return 0.0
+        q = self.walk.q_wheel[0]
+        R = self.items[0].pr.R[0]
+        hs = np.linspace(0.01, 10.0, 400)
+        qs = []
+        for h in hs:
+            m1, m2 = rough_moments(R, h)
+            qs.append((m2 - m1 * m1 + m1 * m1 * 0.25 / 3.0) / 20.0)
+        return float(np.interp(q, qs, hs, right=10.0))
+
+    def walk_k(self, P: dict) -> int:
+        """Parameters the measured walk costs a hypothesis: one, roughness included (its own
+        variance replaces the walk's; had it been free, a roughness at next to no height - the
+        nominal noise without the walk - won every tie by that parameter)."""
+        return 1 if self.walk is not None and self.walk.active else 0
+
     def deviance(self, P: dict) -> tuple[float, float, int]:
-        """(-2 ln L relative to sigma, weighted chi^2, n scalars)."""
-        r = self.resid(P)
-        v = np.broadcast_to(self.sigma**2, r.shape)
-        ev = [it.extra_var(P) for it in self.items]
-        if any(e is not None for e in ev):
-            v = v + np.vstack(
-                [
-                    e if e is not None else np.zeros((it.residuals(P).shape[0], r.shape[1]))
-                    for e, it in zip(ev, self.items, strict=False)
-                ]
-            )
-        chi = float(np.sum(r * r / v))
-        dev = chi + float(np.sum(np.log(v / self.sigma**2)))
-        return dev, chi, r.size
+        """(-2 ln L relative to sigma, chi^2 of the whitened residuals, n scalars)."""
+        zs, logdet = self._whitened(P)
+        chi = float(sum(np.sum(z * z) for z in zs))
+        n = int(sum(z.size for z in zs))
+        return chi + logdet, chi, n
 
     def wresid(self, P: dict) -> np.ndarray:
-        return (self.resid(P) / self.sigma).ravel()
+        zs, _ = self._whitened(P)
+        return np.concatenate([z.ravel() for z in zs])
 
     @cached_property
     def e0(self) -> float:
@@ -137,7 +155,8 @@ class Problem:
         if not getattr(self.items[0], "gof", False):
             return None
         w = self.items[0].noise_weights() > 0
-        z = self.resid(P)[:, w] / self.sigma[w]
+        zs, _ = self._whitened(P)
+        z = np.vstack(zs)[:, w]
         return float((np.sum(z * z) - z.size) / math.sqrt(3.0 * z.size))
 
 
@@ -164,10 +183,11 @@ def estimate_sigma(items: list, mode: str) -> np.ndarray:
         return np.maximum(s, np.array([0.5, 0.5, 1e-4]))
     if mode == "truth":
         for c, ch in enumerate(items[0].channels()):
-            if ch in ("alpha_rad", "beta_rad"):  # encoder quantisation (10 bit: 0.1 deg)
-                floor[c] = items[0].q_rad
-            elif ch == "l_mm":
-                floor[c] = items[0].q_l_mm
+            if ch in ("alpha_rad", "beta_rad", "l_mm"):
+                # encoder quantisation (10 bit: 0.1 deg; 0.1 mm), and the truth's own noise on
+                # the linkage where it is larger (TruthMode.link_sigma)
+                k = ("alpha_rad", "beta_rad", "l_mm").index(ch)
+                floor[c] = max(float(it.link_sigma()[k]) for it in items)
         # the truck channels: the truth's own sample noise (TruthMode.noise_diffs), measured on
         # every sample of every fitting run. A window's increment carries the noise of its two
         # end samples: sqrt(2) sigma per body axis and for the heading. (The spread of the few
@@ -197,7 +217,7 @@ def estimate_sigma(items: list, mode: str) -> np.ndarray:
 
 @dataclass
 class Fit:
-    name: str  # "ed", "ed+bumps", "nominal"
+    name: str  # "ed", "slip@traction", "ed+bumps", "nominal"
     params: dict
     stderr: dict
     dev: float
@@ -205,22 +225,42 @@ class Fit:
     n: int
     k: int
     bumps: list = field(default_factory=list)
+    hyp: Hypothesis | None = None  # None: the nominal model
 
     @property
     def bic(self) -> float:
         return self.dev + self.k * math.log(max(self.n, 2))
 
+    @property
+    def label(self) -> str:
+        """The physics it names ('slip' for any slip law; 'nominal')."""
+        return self.hyp.label if self.hyp is not None else self.name
+
+    def qbic(self, c_hat: float) -> float:
+        """BIC with the deviance divided by an overdispersion c_hat >= 1 (Burnham & Anderson's
+        QAIC with BIC's penalty)."""
+        return self.dev / c_hat + self.k * math.log(max(self.n, 2))
+
+    def model_params(self) -> dict:
+        """The parameters the model takes (bump events are placed separately)."""
+        return {k: v for k, v in self.params.items() if not k.startswith("bumps.")}
+
 
 def fit_params(
-    prob: Problem, keys: list[str], base: dict | None = None, warm: dict | None = None
+    prob: Problem,
+    keys: list[str],
+    base: dict | None = None,
+    warm: dict | None = None,
+    bnd: dict | None = None,
 ) -> tuple[dict, dict]:
     """Bounded least squares of `keys` (others from `base`). `warm`: start values (pairs start
     from their singles' fits, one start; else the catalog start and, for slip/skid, a second)."""
     base = dict(base or {})
     if not keys:
         return base, {}
-    lo, hi, x0 = zip(*(bounds(k) for k in keys), strict=False)
-    x0 = [START.get(k, d) for k, d in zip(keys, x0, strict=False)]
+    bnd = bnd or {}
+    lo, hi, x0 = zip(*(bnd.get(k) or bounds(k) for k in keys), strict=False)
+    x0 = list(x0)
     if warm:
         x0 = [warm.get(k, v) for k, v in zip(keys, x0, strict=False)]
 
@@ -231,16 +271,18 @@ def fit_params(
 
     best = None
     starts = [x0]
-    if not warm and any(k.startswith(("slip", "skid")) for k in keys):
+    if not warm and any(k.startswith(("slip.", "skid.")) for k in keys):
         starts.append(
             [
-                min(h, 0.5) if k.startswith(("slip", "skid")) else s
+                min(h, 0.5) if k.startswith(("slip.", "skid.")) else s
                 for k, s, h in zip(keys, x0, hi, strict=True)
             ]
         )
     for s0 in starts:
         s0 = np.clip(s0, np.array(lo) + 1e-12, np.array(hi) - 1e-12)
-        res = least_squares(f, s0, bounds=(lo, hi), x_scale="jac", max_nfev=60)
+        res = least_squares(
+            f, s0, bounds=(lo, hi), x_scale="jac", max_nfev=60, ftol=1e-6, xtol=1e-6, gtol=1e-6
+        )
         if best is None or res.cost < best.cost:
             best = res
     P = dict(base)
@@ -256,234 +298,52 @@ def fit_params(
     return P, se
 
 
-def evaluate(prob: Problem, name: str, P: dict, se: dict, k: int, bumps=None) -> Fit:
+def evaluate(
+    prob: Problem, name: str, P: dict, se: dict, k: int, bumps=None, hyp: Hypothesis | None = None
+) -> Fit:
     dev, chi, n = prob.deviance(P)
-    return Fit(name, P, se, dev, chi, n, k, bumps or [])
+    return Fit(name, P, se, dev, chi, n, k + prob.walk_k(P), bumps or [], hyp)
 
 
-# ------------------------------------------------------------------------------------------------
-# discrete bumps (truth mode): locate heading steps, fit each with the exact profile, cluster
-# the events of runs of the same path into floor bumps
-# ------------------------------------------------------------------------------------------------
-def _signed_excess(
-    pr: Prepared, truck: int, wheel: int, h: float, s0: float, a: int = 0, b: int | None = None
-) -> np.ndarray:
-    """Heading (rad) a bump under (truck, wheel) adds at ticks a..b (up to a constant)."""
-    b = pr.S.shape[0] if b is None else b
-    e = bump_excess(pr.R[truck], h, pr.S[a:b, truck, wheel] - s0)
-    sg = np.sign(pr.ds[a : b - 1, truck, wheel])
-    d = np.concatenate([[0.0], np.cumsum(sg * np.diff(e))])
-    return (d if wheel == 0 else -d) / pr.b[truck]
+def fit_hypothesis(
+    hyp: Hypothesis,
+    prob: Problem,
+    prs: list,
+    sig_head: float,
+    floor_bumps: list | None = None,
+    warm: dict | None = None,
+    base_params: dict | None = None,
+) -> Fit:
+    """Fit one hypothesis on the problem's runs (`prs` are the same runs, for bump placement).
+    A hypothesis with bumps places floor bumps found by the step detector (`floor_bumps` when the
+    caller has them, else detected under `base_params`, else under a fit of its other members)."""
+    from .bumps import clear_bumps, cluster_bumps, detect_bumps, place_bumps
 
-
-def _step_detector(e: np.ndarray, m: int) -> np.ndarray:
-    """Step estimate at every sample: the step between the m samples either side minus a third
-    of the outer difference, x 1.5: a step's own size at a step, zero for a ramp (drift). The
-    run is continued by its end values, so a bump in a run's first or last second (the last
-    corner of a rectangle) is seen too."""
-    ep = np.pad(e, 2 * m, mode="edge")
-    c = np.concatenate([[0.0], np.cumsum(ep)])
-    k = np.arange(2 * m, ep.size - 2 * m)
-
-    def mean(a, b):
-        return (c[b] - c[a]) / m
-
-    D = (mean(k, k + m) - mean(k - m, k)) - (mean(k + m, k + 2 * m) - mean(k - 2 * m, k - m)) / 3
-    return 1.5 * D
-
-
-def detect_bumps(items: list, P: dict, sigma_head: float) -> list[dict]:
-    """Heading steps in each run's truth-minus-model heading; each refined to (wheel, s0, h)."""
-    events = []
-    for it in items:
-        pr = it.pr
-        for truck in range(it.trucks):
-            mp = it.model_pose(P, truck)
-            e = it.tpose[:, truck, 2] - mp[:, 2]
-            tt = it.tt
-            dt = float(np.median(np.diff(tt)))
-            m = max(3, round(0.5 / dt))
-            if e.size < 4 * m:
-                continue
-            D = _step_detector(e, m)
-            thr = max(8.0 * _mad(D), 6.0 * sigma_head / math.sqrt(m), 2e-4)
-            masked = np.zeros(D.size, dtype=bool)
-            h_grid = np.linspace(0.2, 50.0, 400)
-            dd_grid = bump_dd(pr.R[truck], h_grid)
-            Sa = np.stack([np.interp(tt, pr.t, pr.S[:, truck, w]) for w in (0, 1)])
-            tick_all = np.clip(np.searchsorted(pr.t, tt - 1e-9), 0, pr.t.size - 1)
-            for _ in range(20):
-                absd = np.where(masked, 0.0, np.abs(D))
-                q = int(np.argmax(absd))
-                if absd[q] < thr:
-                    break
-                masked[max(0, q - 2 * m) : q + 2 * m] = True
-                kc = q
-                lo, hi = max(0, kc - 2 * m), min(e.size - 1, kc + 2 * m)
-                best = None
-                # a bump under the left wheel turns the truck left while that wheel rolls
-                # forward (_signed_excess): where both wheels roll one way the step's sign names
-                # the wheel, and its size the height (one start instead of two per wheel)
-                tick = int(np.clip(np.searchsorted(pr.t, tt[kc]), 1, pr.ds.shape[0])) - 1
-                roll = np.sign(pr.ds[tick, truck, :])
-                wheels = [w for w in (0, 1) if (1 if w == 0 else -1) * roll[w] == np.sign(D[q])]
-                if roll[0] != roll[1] or not wheels:
-                    wheels = [0, 1]
-                h0 = float(np.interp(abs(D[q]) * pr.b[truck], dd_grid, h_grid))
-                for w in wheels:
-                    s_lo, s_hi = Sa[w, lo], Sa[w, hi]
-                    if s_hi - s_lo < 20.0:
-                        continue
-                    idx = np.arange(lo, hi + 1)
-                    tick_idx = np.searchsorted(pr.t, tt[idx] - 1e-9)
-                    tick_idx = np.clip(tick_idx, 0, pr.t.size - 1)
-                    ta, tb = int(tick_idx[0]), int(tick_idx[-1]) + 1
-                    ti_loc = tick_idx - ta
-                    # offset and slope of the drift under the step enter linearly: projected
-                    # out (variable projection), the fit moves only height and position
-                    tau = tt[idx] - tt[kc]
-                    Q, _ = np.linalg.qr(np.column_stack([np.ones_like(tau), tau]))
-                    y0 = e[idx]
-
-                    def res(x, pr=pr, w=w, ti=ti_loc, truck=truck, ta=ta, tb=tb, Q=Q, y0=y0):
-                        y = y0 - _signed_excess(pr, truck, w, x[0], x[1], ta, tb)[ti]
-                        return (y - Q @ (Q.T @ y)) / 1e-4
-
-                    s_mid = Sa[w, kc]
-                    try:
-                        r = least_squares(
-                            res,
-                            [h0, s_mid - 30.0],
-                            bounds=([0.2, s_lo - 100], [50.0, s_hi]),
-                            max_nfev=80,
-                        )
-                    except ValueError:
-                        continue
-                    if best is None or r.cost < best[0]:
-                        best = (r.cost, w, r.x)
-                if best is None:
-                    continue
-                _, w, x = best
-                # take the event out of the residual before looking for the next: the detector
-                # answers a step with opposite side lobes of a third of it, and a big bump's ramp
-                # carries them past the mask (spurious "bumps" on the other wheel ~1.2 s later)
-                e = e - _signed_excess(pr, truck, w, x[0], x[1])[tick_all]
-                D = _step_detector(e, m)
-                j = int(np.clip(np.searchsorted(Sa[w], x[1]), 0, tt.size - 1))
-                th = it.tpose[j, truck, 2]
-                half = (0.5 if w == 0 else -0.5) * pr.b[truck]
-                xy = (
-                    it.tpose[j, truck, 0] - half * math.sin(th),
-                    it.tpose[j, truck, 1] + half * math.cos(th),
-                )
-                events.append(
-                    {
-                        "run": pr.run.name,
-                        "group": group_key(pr),
-                        "truck": truck,
-                        "wheel": w,
-                        "s0": float(x[1]),
-                        "h": float(x[0]),
-                        "t_s": float(tt[j]),
-                        "x_mm": float(xy[0]),
-                        "y_mm": float(xy[1]),
-                    }
-                )
-    return events
-
-
-def group_key(pr: Prepared) -> str:
-    """The path a run drove (assign_paths), as '<direction>:<n>'."""
-    if pr.path is None:
-        assign_paths([pr])
-    return pr.path
-
-
-PATH_TRAVEL_TOL = 0.05  # runs of one path: total travel within 5 %, and
-PATH_HEADING_TOL_RAD = 0.35  # heading along the way within 20 deg RMS (room for Eb, Ed errors)
-
-
-def _heading_profile(pr: Prepared, s: np.ndarray) -> np.ndarray:
-    """Truck A's heading from its counts, at distances s (mm) along its travel."""
-    ds = pr.ds[:, 0, :]
-    th = np.concatenate([[0.0], np.cumsum((ds[:, 1] - ds[:, 0]) / pr.b[0])])
-    return np.interp(s, pr.S[:, 0, :].mean(axis=1), th)
-
-
-def assign_paths(prs: list[Prepared]) -> None:
-    """Group runs that drove the same path: the same direction, total travel within 5 % and the
-    heading they turned along the way (from the counts, against distance) within 20 deg RMS.
-    Total travel alone took a clapper's UMBmark square (arcs, 21.5 m) and its 7 x 4 m rectangle
-    (21.6 m) for one path, and a rounded travel put runs of one path on either side of a
-    boundary. Runs of one path share floor bumps and noise estimates and are split together."""
-    reps: list[tuple[str, float, Prepared]] = []
-    counts: dict[str, int] = {}
-    for pr in prs:
-        S = float(pr.S[-1, 0].mean())
-        label = None
-        for key, S0, r in reps:
-            if key.split(":")[0] != pr.run.direction or abs(S - S0) > PATH_TRAVEL_TOL * S0:
-                continue
-            grid = np.linspace(0.0, min(S, S0), 400)
-            d = _heading_profile(pr, grid) - _heading_profile(r, grid)
-            if math.sqrt(float(np.mean(d * d))) <= PATH_HEADING_TOL_RAD:
-                label = key
-                break
-        if label is None:
-            counts[pr.run.direction] = counts.get(pr.run.direction, 0) + 1
-            label = f"{pr.run.direction}:{counts[pr.run.direction]}"
-            reps.append((label, S, pr))
-        pr.path = label
-
-
-def cluster_bumps(events: list[dict], tol_mm: float = 80.0) -> list[dict]:
-    """Events of runs on the same path at the same wheel travel are one floor bump."""
-    out = []
-    keyf = lambda e: (e["group"], e["truck"], e["wheel"])  # noqa: E731
-    for key in sorted({keyf(e) for e in events}):
-        evs = sorted((e for e in events if keyf(e) == key), key=lambda e: e["s0"])
-        cur: list[dict] = []
-        for e in [*evs, None]:
-            if e is not None and (not cur or e["s0"] - cur[-1]["s0"] < tol_mm):
-                cur.append(e)
-                continue
-            if cur:
-                out.append(
-                    {
-                        "group": key[0],
-                        "truck": key[1],
-                        "wheel": key[2],
-                        "s0": float(np.median([c["s0"] for c in cur])),
-                        "h": float(np.median([c["h"] for c in cur])),
-                        "x_mm": float(np.median([c["x_mm"] for c in cur])),
-                        "y_mm": float(np.median([c["y_mm"] for c in cur])),
-                        "t_s": float(np.median([c["t_s"] for c in cur])),
-                        "runs": sorted({c["run"] for c in cur}),
-                    }
-                )
-            cur = [e] if e is not None else []
-    return out
-
-
-def place_bumps(
-    prs: list[Prepared], floor_bumps: list[dict], h: float | None = None, own: bool = False
-) -> None:
-    """Put floor bumps on the runs of their path; `own`: only on the runs whose own events made
-    them (fitting: a path's runs need not share their bumps - rect-7x4 alternates the wheel)."""
-    for pr in prs:
-        g = group_key(pr)
-        pr.bumps = [
-            {
-                "truck": b["truck"],
-                "wheel": b["wheel"],
-                "s0": b["s0"],
-                "h": h if h is not None else b["h"],
-            }
-            for b in floor_bumps
-            if b["group"] == g and (not own or pr.run.name in b.get("runs", ()))
-        ]
-
-
-def clear_bumps(prs: list[Prepared]) -> None:
-    for pr in prs:
-        pr.bumps = []
+    keys = list(hyp.params)
+    clear_bumps(prs)
+    fixed = {}
+    bnd = {}
+    if "roughness" in hyp.families:
+        if prob.walk is not None:  # truth: its height is the measured walk's (rough_from_walk)
+            fixed["roughness.max_height_mm"] = prob.rough_from_walk()
+        elif "roughness.max_height_mm" not in keys:  # returns, linkage: no walk is measured,
+            keys.append("roughness.max_height_mm")  # its height is fitted (its own spread)
+    if not hyp.has_bumps:
+        P, se = fit_params(prob, keys, fixed, warm=warm, bnd=bnd)
+        return evaluate(prob, hyp.name, P, se, len(keys), hyp=hyp)
+    if floor_bumps is not None:
+        fb = floor_bumps
+    else:
+        P0 = {}
+        if keys:
+            P0 = dict(base_params) if base_params is not None else fit_params(prob, keys)[0]
+        fb = cluster_bumps(detect_bumps(prob.items, P0, sig_head))
+    place_bumps(prs, fb, own=True)
+    P, se = fit_params(prob, keys, dict(fixed), warm=warm, bnd=bnd) if keys else (dict(fixed), {})
+    h = float(np.median([b["h"] for b in fb])) if fb else 0.0
+    P = dict(P)
+    P["bumps.height_mm"] = h
+    se["bumps.height_mm"] = float(np.std([b["h"] for b in fb]) / math.sqrt(len(fb))) if fb else 0.0
+    f = evaluate(prob, hyp.name, P, se, len(keys) + 1 + 2 * len(fb), fb, hyp)
+    clear_bumps(prs)
+    return f

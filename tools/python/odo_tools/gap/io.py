@@ -19,9 +19,7 @@ import numpy as np
 
 from .errors import GapInputError
 
-ID_WHEEL = {0x110: 0, 0x111: 1}
-ID_ROTARY = 0x120
-ID_LINEAR = 0x121
+LINE_RE = re.compile(r"^\((\d+\.\d+)\)\s+(\S+)\s+([0-9A-Fa-f]{3,8})#([0-9A-Fa-f]*)$")
 RUN_RE = re.compile(r"^run-(?P<dir>[a-z]+)-(?P<idx>\d+)\.log$")
 
 
@@ -47,11 +45,31 @@ class SignalLayout:
 
 
 @lru_cache(maxsize=1)
-def dbc_layouts() -> dict[int, dict[str, SignalLayout]]:
-    """Signal layouts of the sensor frames from can/odometry.dbc via cantools (the one contract)."""
+def _dbc():
     import cantools
 
-    db = cantools.database.load_file(str(source_dir() / "can" / "odometry.dbc"))
+    return cantools.database.load_file(str(source_dir() / "can" / "odometry.dbc"))
+
+
+def frame_id(name: str) -> int:
+    """A frame's ID by its DBC message name (can/odometry.dbc is the only place IDs live)."""
+    return int(_dbc().get_message_by_name(name).frame_id)
+
+
+# the sensor frames the diagnosis reads, by DBC name
+ID_WHEEL = {frame_id("WHEEL_COUNTS_A"): 0, frame_id("WHEEL_COUNTS_B"): 1}
+ID_ROTARY = frame_id("LINK_ROTARY")
+ID_LINEAR = frame_id("LINK_LINEAR")
+FRAME_LEN = {
+    fid: int(_dbc().get_message_by_frame_id(fid).length)
+    for fid in (*ID_WHEEL, ID_ROTARY, ID_LINEAR)
+}
+
+
+@lru_cache(maxsize=1)
+def dbc_layouts() -> dict[int, dict[str, SignalLayout]]:
+    """Signal layouts of the sensor frames from can/odometry.dbc via cantools (the one contract)."""
+    db = _dbc()
     out: dict[int, dict[str, SignalLayout]] = {}
     for fid in (*ID_WHEEL, ID_ROTARY, ID_LINEAR):
         msg = db.get_message_by_frame_id(fid)
@@ -282,20 +300,36 @@ def read_log(path: str | Path, robot: Robot) -> SensorLog:
 
 
 def _align(path: Path, t_frames: np.ndarray, t_ticks: np.ndarray, lines: np.ndarray) -> np.ndarray:
-    idx = np.searchsorted(t_ticks, t_frames - 1e-7)
-    idx = np.clip(idx, 0, t_ticks.size - 1)
-    off = np.abs(t_ticks[idx] - t_frames) > 1e-5
-    if off.any():
+    """The tick each frame belongs to: the nearest WHEEL_COUNTS_A frame, within half a tick;
+    -1 for a frame of a tick whose WHEEL_COUNTS_A frame was lost (_fill skips it).
+
+    A robot's controllers put one tick's frames on the bus a little apart (the independent
+    world stamps them a few hundred microseconds after each other, as a real bus does), and a
+    bus loses a frame now and then: a tick without its WHEEL_COUNTS_A frame has no sample (the
+    counters are cumulative, so its travel shows in the next tick) and its other frames are
+    dropped with it. Only a log where most frames belong to no tick is refused."""
+    n = t_ticks.size
+    half = 0.5 * float(np.median(np.diff(t_ticks))) if n > 1 else 0.5
+    j = np.searchsorted(t_ticks, t_frames)
+    left, right = np.clip(j - 1, 0, n - 1), np.clip(j, 0, n - 1)
+    closer_left = np.abs(t_frames - t_ticks[left]) <= np.abs(t_ticks[right] - t_frames)
+    idx = np.where(closer_left, left, right)
+    off = np.abs(t_ticks[idx] - t_frames) >= half
+    if off.mean() > 0.5:
         raise GapInputError(
             path,
-            "frame without a WHEEL_COUNTS_A frame of the same tick",
+            "frame without a WHEEL_COUNTS_A frame of the same tick (most frames are half a tick "
+            "or more from every one)",
             int(lines[np.argmax(off)]) + 1,
         )
-    return idx
+    return np.where(off, -1, idx)
 
 
 def _fill(v: np.ndarray, idx: np.ndarray, n: int) -> np.ndarray:
-    """Values per tick; a tick without a frame holds the previous value (the decoder's register)."""
+    """Values per tick; a tick without a frame holds the previous value (the decoder's register).
+    Frames of no tick (idx -1, _align) are skipped."""
+    keep = idx >= 0
+    v, idx = np.asarray(v)[keep], idx[keep]
     out = np.full(n, np.nan)
     out[idx] = v
     if np.isnan(out[0]):
@@ -407,11 +441,13 @@ def read_returns(path: str | Path) -> dict[tuple[str, int], np.ndarray]:
 
 @dataclass
 class RunData:
-    name: str  # run-cw-01
+    name: str  # run-cw-01; "<session>/run-cw-01" when runs come from several folders
     direction: str  # cw / ccw / fwd / ...
     log: SensorLog
     truth: Truth | None = None
     ret: np.ndarray | None = None  # true return pose (returns.csv)
+    session: str = ""  # the folder the run was recorded into (one session per folder)
+    path: str = ""  # the log file
 
 
 def discover(real: str | Path, robot: Robot) -> list[RunData]:
@@ -422,17 +458,112 @@ def discover(real: str | Path, robot: Robot) -> list[RunData]:
     logs = sorted(p for p in real.iterdir() if p.name.endswith(".log"))
     if not logs:
         raise GapInputError(real, "no run-*.log files")
+    for p in logs:
+        if RUN_RE.match(p.name) is None:
+            raise GapInputError(p, "expected a name run-<direction>-NN.log")
+    _same_robot_in_folder(real, logs)
     rets = read_returns(real / "returns.csv") if (real / "returns.csv").exists() else {}
     runs = []
     for p in logs:
         m = RUN_RE.match(p.name)
-        if m is None:
-            raise GapInputError(p, "expected a name run-<direction>-NN.log")
         d, k = m.group("dir"), int(m.group("idx"))
         log = read_log(p, robot)
         tp = p.with_suffix(".truth.csv")
         truth = read_truth(tp, robot) if tp.exists() else None
-        runs.append(RunData(p.stem, d, log, truth, rets.get((d, k))))
+        runs.append(RunData(p.stem, d, log, truth, rets.get((d, k)), real.name, str(p)))
+    return runs
+
+
+SCAN_LINES = 2000  # enough of a log to read its cycle and which trucks it carries
+
+
+def _log_signature(p: Path) -> tuple[float | None, bool]:
+    """(median cycle of the WHEEL_COUNTS_A frames in the log's first lines, whether it carries
+    WHEEL_COUNTS_B frames): what tells one robot's recording from another's."""
+    ida, idb = (f"{fid:03X}#" for fid in ID_WHEEL)
+    ts, has_b = [], False
+    try:
+        with p.open() as f:
+            for i, ln in enumerate(f):
+                if i >= SCAN_LINES:
+                    break
+                m = LINE_RE.match(ln.strip())
+                if m is None:
+                    continue
+                key = f"{int(m.group(3), 16):03X}#"
+                if key == ida:
+                    ts.append(float(m.group(1)))
+                has_b |= key == idb
+    except (OSError, UnicodeDecodeError):
+        return None, False  # read_log names the problem
+    dt = np.diff(ts)
+    return (float(np.median(dt)) if dt.size else None), has_b
+
+
+def _same_robot_in_folder(real: Path, logs: list[Path]) -> None:
+    """Runs of one folder must come from one robot: the same control cycle and the same trucks.
+    A folder that mixes robots would be diagnosed against one robot's description and blamed on
+    an effect; say so instead."""
+    sig = {p: _log_signature(p) for p in logs}
+    cyc = {p: c for p, (c, _) in sig.items() if c is not None}
+    if cyc:
+        lo, hi = min(cyc, key=cyc.get), max(cyc, key=cyc.get)
+        if cyc[hi] > 1.1 * cyc[lo]:
+            raise GapInputError(
+                real,
+                f"runs of different robots in one folder: {lo.name} ticks every "
+                f"{cyc[lo] * 1e3:.1f} ms, {hi.name} every {cyc[hi] * 1e3:.1f} ms",
+            )
+    two = {p for p, (_, b) in sig.items() if b}
+    if two and len(two) != len(logs):
+        one = next(p for p in logs if p not in two)
+        raise GapInputError(
+            real,
+            f"runs of different robots in one folder: {next(iter(sorted(two))).name} carries "
+            f"truck B's wheel counts, {one.name} does not",
+        )
+
+
+def _robot_geometry(raw: dict) -> dict:
+    """What makes two robot descriptions the same robot (not their prose)."""
+    keep = ("vehicle", "tick_ms", "trucks", "linkage", "trailer")
+    return {k: raw.get(k) for k in keep}
+
+
+def discover_all(folders: list[str | Path], robot: Robot) -> list[RunData]:
+    """The runs of one or more folders, one recording session each (`RunData.session`). With
+    several folders run names carry their session ("square/run-cw-01"). Folders that hold a
+    robot.json (odo-import and the blind check write one) must describe the same robot."""
+    folders = [Path(f) for f in folders]
+    if not folders:
+        raise GapInputError("--real", "no folder of recorded runs given")
+    seen: dict[str, Path] = {}
+    geo: tuple[Path, dict] | None = None
+    for f in folders:
+        rp = f / "robot.json"
+        if rp.is_file():
+            try:
+                g = _robot_geometry(json.loads(rp.read_text()))
+            except (OSError, json.JSONDecodeError, AttributeError):
+                raise GapInputError(rp, "unreadable robot description") from None
+            if geo is None:
+                geo = (rp, g)
+            elif g != geo[1]:
+                diff = next(k for k in g if g[k] != geo[1].get(k))
+                raise GapInputError(
+                    rp, f"runs of different robots: differs from {geo[0]} in '{diff}'"
+                )
+    runs: list[RunData] = []
+    for f in folders:
+        label = f.name or str(f)
+        if label in seen and seen[label] != f.resolve():
+            label = f"{f.parent.name}/{f.name}"
+        seen[label] = f.resolve()
+        for r in discover(f, robot):
+            r.session = label
+            if len(folders) > 1:
+                r.name = f"{label}/{r.name}"
+            runs.append(r)
     return runs
 
 
@@ -446,9 +577,6 @@ def encode_payload(fid: int, values: dict[str, np.ndarray]) -> np.ndarray:
         raw &= (1 << s.length) - 1
         out |= raw.astype(np.uint64) << np.uint64(s.start)
     return out
-
-
-FRAME_LEN = {0x110: 8, 0x111: 8, ID_ROTARY: 6, ID_LINEAR: 6}
 
 
 def write_candump(path: Path, frames: list[tuple[np.ndarray, int, np.ndarray]]) -> None:

@@ -33,7 +33,8 @@ class Prepared:
     # rolls passively, so the drive effects (slip, skid: world.c step_driven) never act on it
     driven: list[bool] = field(default_factory=lambda: [True, True])
     link: tuple | None = None  # clapper: (l0, alpha0, beta0, l_min, l_max, at_limit) (mm, rad)
-    path: str | None = None  # which path the run drove (fit.assign_paths)
+    path: str | None = None  # which path the run drove (paths.assign_paths)
+    shape: str | None = None  # the path without its direction (paths.assign_shapes)
     slip_cache: dict = field(default_factory=dict, repr=False)  # slip_loss results by parameters
     track_cache: dict = field(default_factory=dict, repr=False)  # _track results by parameters
 
@@ -43,7 +44,9 @@ def prepare(run: RunData, robot: Robot) -> Prepared:
     n, T = c.shape[0], c.shape[1]
     ds = np.zeros((n - 1, T, 2))
     for t in range(T):
-        bits = robot.trucks[t]["counter_bits"]
+        # the frame carries the counter's low bits (can/odometry.dbc: 24): a 32-bit decoder
+        # wraps on the bus at 2^24, a 16-bit one at 2^16
+        bits = min(robot.trucks[t]["counter_bits"], _count_bits(t))
         mod, half = 1 << bits, 1 << (bits - 1)
         d = (np.diff(c[:, t, :], axis=0) + half) % mod - half  # counter wraparound
         if robot.trucks[t]["invert_left"]:
@@ -63,6 +66,14 @@ def prepare(run: RunData, robot: Robot) -> Prepared:
         driven=[t == 0 or robot.vehicle == "clapper" for t in range(T)],
         link=_link_start(run, robot),
     )
+
+
+def _count_bits(truck: int) -> int:
+    """Width of a wheel counter in the WHEEL_COUNTS frames (can/odometry.dbc)."""
+    from .io import ID_WHEEL, dbc_layouts
+
+    fid = next(f for f, t in ID_WHEEL.items() if t == truck)
+    return int(dbc_layouts()[fid]["LeftCount"].length)
 
 
 def _link_start(run: RunData, robot: Robot) -> tuple | None:
@@ -152,8 +163,22 @@ def rough_window_var(R: float, hmax: float, L: np.ndarray, n: int = 32) -> tuple
     return (dd * dd * q).mean(axis=1), (dd * q).mean(axis=1), q.mean(axis=1)
 
 
-def floor_travel(pr: Prepared, P: dict, truck: int) -> tuple[np.ndarray, float, np.ndarray]:
-    """(n-1, 2) floor travel per tick, true wheelbase, (n-1,) lateral skid per tick (mm)."""
+def truck_view(P: dict, truck: int) -> dict:
+    """The parameters that act on one truck: 'effect.param' acts on every truck, and
+    'effect.param.A' / '.B' on that truck only (a hypothesis scoped to one truck: the
+    independent world puts a truck-scoped effect on one truck of a clapper or set)."""
+    out = {k: v for k, v in P.items() if not k.endswith((".A", ".B"))}
+    suf = "." + "AB"[truck]
+    out.update({k[:-2]: v for k, v in P.items() if k.endswith(suf)})
+    return out
+
+
+def floor_travel(
+    pr: Prepared, P: dict, truck: int
+) -> tuple[np.ndarray, float, np.ndarray, np.ndarray | None]:
+    """(n-1, 2) floor travel per tick, true wheelbase, (n-1,) lateral skid per tick (mm), (n-1,)
+    factor on each tick's heading change (scrub; None when there is none)."""
+    P = truck_view(P, truck)
     ds = pr.ds[:, truck, :].copy()
     R, b = pr.R[truck], pr.b[truck]
     gl, gr = wheel_factors(P, R, b)
@@ -169,6 +194,12 @@ def floor_travel(pr: Prepared, P: dict, truck: int) -> tuple[np.ndarray, float, 
     k = P.get("slip.k_per_m_s2", 0.0) if drive else 0.0
     if k > 0:
         ds += slip_loss(pr, P, truck, k)
+    if drive and P.get("slip@accel.k_per_m_s2", 0.0) > 0:
+        ds = slip_accel(pr, ds, P)
+    if drive and P.get("slip@traction.a_max_m_s2", 0.0) > 0:
+        ds = slip_traction(pr, ds, P["slip@traction.a_max_m_s2"])
+    if P.get("count_loss@speed.k_per_m_s", 0.0) > 0:
+        ds = count_loss_speed(pr, ds, truck, P)
     for ev in pr.bumps:
         if ev["truck"] != truck:
             continue
@@ -185,14 +216,78 @@ def floor_travel(pr: Prepared, P: dict, truck: int) -> tuple[np.ndarray, float, 
         ds[i0:i1, w] -= np.sign(pr.ds[i0:i1, truck, w]) * np.diff(e)
     bt = b * P.get("eb.value", 1.0)
     lat = np.zeros(ds.shape[0])
+    g = scrub_factor(ds, P.get("scrub.k", 0.0)) if drive else None
     ks = P.get("skid.k_s", 0.0) if drive else 0.0
     if ks > 0:
         v = 0.5 * (ds[:, 0] + ds[:, 1]) / pr.dt
-        om = (ds[:, 1] - ds[:, 0]) / bt / pr.dt
+        om = (ds[:, 1] - ds[:, 0]) / bt / pr.dt * (1.0 if g is None else g)
         ac = v * om * 1e-3
         ex = np.maximum(np.abs(ac) - P.get("skid.a0_m_s2", 0.3), 0.0)
         lat = -np.sign(ac) * ks * ex * 1e3 * pr.dt
-    return ds, bt, lat
+    return ds, bt, lat, g
+
+
+def scrub_factor(ds: np.ndarray, k: float) -> np.ndarray | None:
+    """Catalog `scrub` (host_sim world.c scrub_factor): each tick's heading change times
+    g = 1 - k m / v, v = |dL| + |dR|, m = 2 min(|dL|, |dR|) when both wheels roll one way."""
+    if k == 0.0:
+        return None
+    a = np.abs(ds)
+    v = a.sum(axis=1)
+    same = (ds[:, 0] * ds[:, 1]) > 0.0
+    m = np.where(same, 2.0 * a.min(axis=1), 0.0)
+    return 1.0 - k * m / np.where(v > 0.0, v, 1.0)
+
+
+# ------------------------------------------------------------------------------------------------
+# laws other than the catalog's, for the same physics (the diagnosis names the effect by its
+# physics and reports the law that fitted; hypotheses.LAWS)
+# ------------------------------------------------------------------------------------------------
+def _wheel_speeds(pr: Prepared, ds: np.ndarray) -> np.ndarray:
+    """(n-1, 2) mean speed of each wheel over each tick (mm/s)."""
+    return ds / pr.dt[:, None]
+
+
+def slip_accel(pr: Prepared, ds: np.ndarray, P: dict) -> np.ndarray:
+    """Slip tied to the wheel's acceleration as the counts show it, tick by tick: fraction
+    s = min(cap, k max(0, |a| - a0)) with a the change of the tick's mean speed; speeding up the
+    wheel spins (floor = (1 - s) counted), slowing down it drags (floor = counted / (1 - s)). No
+    motor lag, no sub-steps: the law a user would write down from the counts alone."""
+    k = P["slip@accel.k_per_m_s2"]
+    a0 = P.get("slip@accel.a0_m_s2", 0.0)
+    cap = 0.5
+    v = _wheel_speeds(pr, ds)
+    vp = np.vstack([np.zeros((1, 2)), v[:-1]])
+    a = np.abs(v - vp) / pr.dt[:, None] * 1e-3
+    s = np.minimum(k * np.maximum(a - a0, 0.0), cap)
+    up = np.abs(v) >= np.abs(vp)
+    return ds * np.where(up, 1.0 - s, 1.0 / (1.0 - s))
+
+
+def slip_traction(pr: Prepared, ds: np.ndarray, a_max: float) -> np.ndarray:
+    """Slip at traction (torque) saturation: the floor speed follows the wheel's surface speed
+    but changes by at most a_max (m/s^2); the wheel spins while it is ahead and drags while it is
+    behind. One rate limiter per wheel, tick by tick."""
+    v = _wheel_speeds(pr, ds)
+    lim = a_max * 1e3 * pr.dt  # mm/s per tick
+    u = np.empty_like(v)
+    cur = np.zeros(2)
+    for i in range(v.shape[0]):  # a rate limiter is sequential: ~2 us per tick
+        cur = cur + np.clip(v[i] - cur, -lim[i], lim[i])
+        u[i] = cur
+    return u * pr.dt[:, None]
+
+
+def count_loss_speed(pr: Prepared, ds: np.ndarray, truck: int, P: dict) -> np.ndarray:
+    """Counts lost above a wheel speed: of the wheel's true travel a fraction
+    lam = min(0.9, k max(0, |v| - v0)) (v in m/s, from the counts) never reaches the counter,
+    so the floor travel is counted / (1 - lam). Covers a hard count-rate limit (every tick at the
+    plateau loses alike) and edges missed with a probability rising with speed."""
+    k = P["count_loss@speed.k_per_m_s"]
+    v0 = P.get("count_loss@speed.v0_mm_s", 0.0)
+    v = np.abs(pr.ds[:, truck, :]) / pr.dt[:, None]
+    lam = np.minimum(k * np.maximum(v - v0, 0.0) * 1e-3, 0.9)
+    return ds / (1.0 - lam)
 
 
 SLIP_SUB_S = 0.001  # sub-step of the slip integral (the catalog's law acts per physics step)
@@ -234,42 +329,80 @@ def slip_loss(pr: Prepared, P: dict, truck: int, k: float) -> np.ndarray:
     hit = pr.slip_cache.get(key)
     if hit is not None:  # fits re-evaluate one (k, tau) for every other parameter they move
         return hit
+    sub = _slip_substep_terms(pr, truck, tau, a0)
+    out = np.zeros((pr.ds.shape[0], 2))
+    if sub is not None:
+        idx, ex, vms, up = sub
+        sfr = np.minimum(k * ex, cap)
+        per = np.where(up, -sfr, sfr / (1.0 - sfr)) * vms
+        out.ravel()[:] = np.bincount(idx, weights=per, minlength=out.size)
+    _cache_put(pr.slip_cache, key, out)
+    return out
+
+
+def _cache_put(cache: dict, key: tuple, value) -> None:
+    """Bounded cache: at most 16 results and 8 sets of sub-step terms."""
+    kind = key[0] == "terms"
+    same = [k for k in cache if (k[0] == "terms") == kind]
+    if len(same) >= (8 if kind else 16):
+        for k in same:
+            del cache[k]
+    cache[key] = value
+
+
+def _slip_substep_terms(pr: Prepared, truck: int, tau: float, a0: float):
+    """The sub-steps where the drive accelerates beyond a0, for a drive lag tau: (flat index of
+    the tick and wheel, acceleration excess over a0 in m/s^2, speed x sub-step in mm, speeding
+    up?). Independent of k, so a fit that moves k reuses them (cached per tau and a0)."""
+    key = ("terms", truck, tau, a0)
+    if key in pr.slip_cache:
+        return pr.slip_cache[key]
     M = max(1, round(float(np.median(pr.dt)) / SLIP_SUB_S))
     v = pr.ds[:, truck, :] / pr.dt[:, None]  # mm/s, mean over each tick
     c, m0 = drive_commands(v, tau, M)
     g = 1.0 - math.exp(-SLIP_SUB_S / tau)
-    out = np.zeros_like(v)
     # only ticks whose first (largest) sub-step acceleration exceeds a0 slip at all
     a_first = np.abs(c - m0) * (g / SLIP_SUB_S * 1e-3)
-    sel = a_first > a0
-    if sel.any():
-        # the acceleration decays by q = 1 - g per sub-step: beyond J sub-steps none exceeds a0
-        J = M
+    sel = np.flatnonzero((a_first > a0).ravel())
+    res = None
+    if sel.size:
+        # the acceleration decays by q = 1 - g per sub-step: tick i slips for its first J_i
+        # sub-steps only (ragged: a tick barely over a0 costs one sub-step, not M)
+        q = 1.0 - g
+        af = a_first.ravel()[sel]
         if a0 > 0.0:
-            J = int(min(M, 1 + math.ceil(math.log(a0 / a_first[sel].max()) / math.log(1.0 - g))))
-        out[sel] = _slip_substeps(c[sel], m0[sel], g, J, k, a0, cap)
-    if len(pr.slip_cache) > 16:
-        pr.slip_cache.clear()
-    pr.slip_cache[key] = out
-    return out
+            J = np.minimum(M, 1 + np.ceil(np.log(a0 / af) / math.log(q))).astype(np.int64)
+        else:
+            J = np.full(sel.size, M, dtype=np.int64)
+        J = np.maximum(J, 1)
+        rows = np.repeat(sel, J)
+        starts = np.repeat(np.cumsum(J) - J, J)
+        j = np.arange(rows.size) - starts + 1  # sub-step 1..J_i
+        cs, ms = c.ravel()[rows], m0.ravel()[rows]
+        qj = q ** j.astype(float)
+        v1 = cs + (ms - cs) * qj  # speed after sub-step j
+        v0 = cs + (ms - cs) * qj / q  # and before it
+        ex = np.abs(v1 - v0) / SLIP_SUB_S * 1e-3 - a0
+        keep = ex > 0.0
+        up = np.abs(v1) >= np.abs(v0)
+        res = (rows[keep], ex[keep], (v1 * SLIP_SUB_S)[keep], up[keep])
+    _cache_put(pr.slip_cache, key, res)
+    return res
 
 
-def _slip_substeps(c, m0, g, J, k, a0, cap) -> np.ndarray:
-    """Slip travel of the first J sub-steps of the selected ticks (see slip_loss)."""
-    cs, ms = c[:, None], m0[:, None]
-    qj = (1.0 - g) ** np.arange(J + 1)  # (J + 1,): sub-step j = 0 is the tick's start
-    vm = cs + (ms - cs) * qj  # (nsel, M + 1) speed after each sub-step
-    acc = np.abs(np.diff(vm, axis=1)) / SLIP_SUB_S * 1e-3  # m/s^2
-    sfr = np.minimum(k * np.maximum(acc - a0, 0.0), cap)
-    up = np.abs(vm[:, 1:]) >= np.abs(vm[:, :-1])
-    per = np.where(up, -sfr, sfr / (1.0 - sfr)) * vm[:, 1:] * SLIP_SUB_S
-    return per.sum(axis=-1)
-
-
-def integrate(ds: np.ndarray, b: float, lat: np.ndarray, pose0=(0.0, 0.0, 0.0)) -> np.ndarray:
-    """Dead reckoning along the exact arc of each tick; returns (n, 3) x, y, theta."""
+def integrate(
+    ds: np.ndarray,
+    b: float,
+    lat: np.ndarray,
+    g: np.ndarray | None = None,
+    pose0=(0.0, 0.0, 0.0),
+) -> np.ndarray:
+    """Dead reckoning along the exact arc of each tick; returns (n, 3) x, y, theta. `g` scales
+    each tick's heading change (scrub)."""
     d = 0.5 * (ds[:, 0] + ds[:, 1])
     dth = (ds[:, 1] - ds[:, 0]) / b
+    if g is not None:
+        dth = dth * g
     th = pose0[2] + np.concatenate([[0.0], np.cumsum(dth)])
     half = 0.5 * dth
     with np.errstate(invalid="ignore", divide="ignore"):
@@ -282,12 +415,17 @@ def integrate(ds: np.ndarray, b: float, lat: np.ndarray, pose0=(0.0, 0.0, 0.0)) 
     return np.column_stack([x, y, th])
 
 
+# effects on the linkage encoders' readings only: the trucks' tracks do not depend on them, so a
+# fit of them reuses the cached tracks instead of dead-reckoning again for every step
+SENSOR_ONLY = ("rotary_bias.", "link_bias.")
+
+
 def _track(pr: Prepared, P: dict, truck: int) -> np.ndarray:
     """One truck's dead-reckoned track from the origin under P (cached per run: a clapper's
     clamp needs both trucks for each, and fits ask for each truck in turn)."""
     key = (
         truck,
-        tuple(sorted(P.items())),
+        tuple(sorted((k, v) for k, v in P.items() if not k.startswith(SENSOR_ONLY))),
         tuple((b["truck"], b["wheel"], b["s0"], b["h"]) for b in pr.bumps),
     )
     hit = pr.track_cache.get(key)
@@ -302,7 +440,7 @@ def dead_reckon(pr: Prepared, P: dict, truck: int = 0, pose0=(0.0, 0.0, 0.0)) ->
     if tuple(pose0) == (0.0, 0.0, 0.0):
         p = _track(pr, P, truck)
     else:
-        p = integrate(*floor_travel(pr, P, truck), pose0)
+        p = integrate(*floor_travel(pr, P, truck), pose0=pose0)
     if pr.link is None or len(pr.R) < 2:
         return p.copy()
     return _clamp_link(pr, p, _track(pr, P, 1 - truck), truck, pose0)

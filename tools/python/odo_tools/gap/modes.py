@@ -12,15 +12,57 @@
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass, field
+from typing import Protocol
 
 import numpy as np
 
 from .io import Robot
-from .model import Prepared, dead_reckon, link_bias, rough_moments, rough_window_var, wrap_rad
+from .model import (
+    Prepared,
+    dead_reckon,
+    link_bias,
+    rough_moments,
+    rough_window_var,
+    truck_view,
+    wrap_rad,
+)
 
 WINDOW_S = 0.4  # truth increments: window length
 HORIZON_S = 1.0  # linkage mode: prediction horizon
 ANCHOR_S = 2.0  # truth mode: the start pose is fitted over this much of the run
+
+
+class EvidenceMode(Protocol):
+    """What every evidence mode offers the fits, the held-out evaluation and the plots. One
+    object per run; `P` is a hypothesis (catalog parameters 'effect.param', absent = nominal)."""
+
+    name: str
+    pr: Prepared
+
+    def channels(self) -> list[str]:
+        """Names of the residual columns, with units in the suffix."""
+        ...
+
+    def residuals(self, P: dict) -> np.ndarray:
+        """(rows, channels) recorded minus model."""
+        ...
+
+    def extra_var(self, P: dict) -> np.ndarray | None:
+        """Variance a hypothesis adds to each residual (roughness), or None."""
+        ...
+
+    def noise_weights(self) -> np.ndarray:
+        """Expected z^2 per value of each channel under noise alone."""
+        ...
+
+    def sys_z(self, P: dict, sigma: np.ndarray) -> np.ndarray:
+        """Standardised residuals of the held-out gap (diagnose: systematic gap)."""
+        ...
+
+    def gap(self, P: dict) -> float:
+        """The gap a person reads, in mm."""
+        ...
 
 
 def _body_inc(p: np.ndarray, i: np.ndarray, j: np.ndarray) -> np.ndarray:
@@ -43,25 +85,103 @@ def _censored(x: np.ndarray, code: np.ndarray, step: float, angle: bool) -> np.n
     return np.clip(d, -tol, step + tol) - d
 
 
+def to_centre(pose: np.ndarray, lever_mm: list[tuple[float, float]]) -> np.ndarray:
+    """Tracked-point poses (n, trucks, 3) -> axle-centre poses: subtract the lever arm (x forward,
+    y left, mm) rotated by the measured heading."""
+    out = pose.copy()
+    for t in range(pose.shape[1]):
+        ox, oy = lever_mm[t] if t < len(lever_mm) else (0.0, 0.0)
+        if ox == 0.0 and oy == 0.0:
+            continue
+        c, s_ = np.cos(pose[:, t, 2]), np.sin(pose[:, t, 2])
+        out[:, t, 0] -= c * ox - s_ * oy
+        out[:, t, 1] -= s_ * ox + c * oy
+    return out
+
+
+def spot_ticks(pr: Prepared) -> np.ndarray:
+    """(n-1, trucks): ticks whose wheels roll opposite ways (a turn on the spot)."""
+    return (pr.ds[:, :, 0] * pr.ds[:, :, 1]) < 0.0
+
+
+def link_from_poses(pose: np.ndarray, robot: Robot) -> np.ndarray:
+    """(n, 3) alpha, beta (rad), l (mm) of a clapper (theta_L from B to A, 002 Eqs. 10, 11 as
+    host_sim's world.c) or alpha and the bar length of a set (alpha = theta_A - theta_trailer),
+    from the trucks' poses (n, 2, 3)."""
+    a, b = pose[:, 0], pose[:, 1]
+    if robot.vehicle == "clapper":
+        thl = np.arctan2(a[:, 1] - b[:, 1], a[:, 0] - b[:, 0])
+        return np.column_stack(
+            [
+                wrap_rad(a[:, 2] - thl),
+                wrap_rad(b[:, 2] - thl),
+                np.hypot(a[:, 0] - b[:, 0], a[:, 1] - b[:, 1]),
+            ]
+        )
+    L = robot.trailer.get("trailer_length_mm", 0.0)
+    return np.column_stack(
+        [wrap_rad(a[:, 2] - b[:, 2]), np.zeros(a.shape[0]), np.full(a.shape[0], L)]
+    )
+
+
+def _sample_noise(t: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """Per column of x (n, k): white noise sigma of the samples, from second divided differences
+    (robust: a median)."""
+    h1, h2 = np.diff(t)[:-1], np.diff(t)[1:]
+    ok = (h1 > 0) & (h2 > 0)
+    if ok.sum() < 10:
+        return np.zeros(x.shape[1])
+    h1, h2 = h1[ok], h2[ok]
+    w0, w2 = 1.0 / h1, 1.0 / h2
+    w1 = w0 + w2
+    d = (w2[:, None] * x[2:][ok] - w1[:, None] * x[1:-1][ok] + w0[:, None] * x[:-2][ok]) * np.sqrt(
+        6.0 / (w0 * w0 + w1 * w1 + w2 * w2)
+    )[:, None]
+    med = np.median(d, axis=0)
+    return 1.4826 * np.median(np.abs(d - med), axis=0) / math.sqrt(6.0)
+
+
 def _grain_count_cv2(P: dict) -> float:
     """Squared coefficient of variation of the grain count: gaps spacing * (1 + jitter U(-1, 1))
     make a renewal count of variance n cv^2, cv^2 = jitter^2 / 3."""
     return P.get("roughness.jitter", 0.5) ** 2 / 3.0
 
 
+@dataclass
+class Instrument:
+    """How the truth was measured, beyond its noise: where the tracked point sits on each truck
+    (x forward, y left of the axle centre, mm) and how late each run's truth is against the
+    robot's clock (s; the truth sample stamped t shows the pose at t - latency). Nuisances of the
+    truth, estimated from the data (instrument.estimate), never part of a hypothesis."""
+
+    lever_mm: list[tuple[float, float]] = field(default_factory=lambda: [(0.0, 0.0)] * 2)
+    lever_se_mm: list[tuple[float, float]] = field(default_factory=lambda: [(0.0, 0.0)] * 2)
+    latency_s: dict[str, float] = field(default_factory=dict)
+
+
 class TruthMode:
     name = "truth"
     gof = True  # its noise is measured per sample (TruthMode.noise_diffs): a fit test holds
 
-    def __init__(self, pr: Prepared, robot: Robot) -> None:
+    def __init__(self, pr: Prepared, robot: Robot, instrument: Instrument | None = None) -> None:
         tr = pr.run.truth
         assert tr is not None
         self.pr, self.robot = pr, robot
-        t0, t1 = max(tr.t_s[0], pr.t[0]), min(tr.t_s[-1], pr.t[-1])
-        sel = (tr.t_s >= t0 - 1e-9) & (tr.t_s <= t1 + 1e-9)
-        self.tt = tr.t_s[sel]
-        self.tpose = tr.pose[sel]
-        self.tlink = tr.link[sel] if tr.link is not None else None
+        inst = instrument or Instrument()
+        lat = inst.latency_s.get(pr.run.name, 0.0)
+        t_true = tr.t_s - lat
+        t0, t1 = max(t_true[0], pr.t[0]), min(t_true[-1], pr.t[-1])
+        sel = (t_true >= t0 - 1e-9) & (t_true <= t1 + 1e-9)
+        if sel.sum() < 10:
+            raise ValueError(f"{pr.run.name}: fewer than 10 truth samples overlap the log")
+        self.tt = t_true[sel]
+        self.tpose = to_centre(tr.pose[sel], inst.lever_mm)
+        # the true linkage from the two trucks' (centre) poses, with the same lever arms and
+        # latency as the trucks: a linkage column the motion capture derived from its markers
+        # carries their lever arms as offsets a rotary or link-length bias would take up (the
+        # independent world's clapper); the simulator's exact columns agree with this to the
+        # truth's noise
+        self.tlink = link_from_poses(self.tpose, robot) if tr.link is not None else None
         dt = float(np.median(np.diff(self.tt)))
         W = max(1, round(WINDOW_S / dt))
         self.i = np.arange(0, self.tt.size - W, W)
@@ -90,6 +210,15 @@ class TruthMode:
                     lg.l_mm[k] if lg.l_mm is not None else np.zeros(k.size),
                 ]
             )
+            # the true linkage is measured too (by the motion capture, from two markers): where
+            # its own noise exceeds the encoder's cell the reading is compared with it as a
+            # Gaussian channel (cell centre, noise + quantisation), else interval-censored (the
+            # simulator's exact linkage). A 2.6 m link tracked at 0.5 mm per marker is ~0.7 mm
+            # of noise against a 0.02 mm linear encoder cell: censoring read that as a misfit
+            # 10^5 times the noise (the independent world's clapper).
+            self.link_noise = _sample_noise(self.tt, self.tlink)
+            steps = np.array([self.step_rad, self.step_rad, self.step_l_mm])
+            self.link_gauss = self.link_noise > steps / math.sqrt(12.0)
         # nominal travel in each window (roughness variance; stationary detection)
         S = pr.S
         self.wtravel = np.stack(
@@ -102,6 +231,19 @@ class TruthMode:
                 for t in range(self.trucks)
             ]
         )  # (trucks, 2, nwin)
+        # the part of it (both wheels summed) turned on the spot: the background walks at its
+        # own rate there (background.py: the OptiOdom robot's walk lives on its spot turns)
+        spot = spot_ticks(pr)  # (n-1, trucks)
+        St = np.concatenate(
+            [np.zeros((1, pr.ds.shape[1])), np.cumsum(np.abs(pr.ds).sum(axis=2) * spot, axis=0)]
+        )
+        self.wturn = np.stack(
+            [
+                np.interp(self.tt[self.j], pr.t, St[:, t])
+                - np.interp(self.tt[self.i], pr.t, St[:, t])
+                for t in range(self.trucks)
+            ]
+        )  # (trucks, nwin)
 
     def model_pose(self, P: dict, truck: int) -> np.ndarray:
         p = dead_reckon(self.pr, P, truck)
@@ -122,8 +264,16 @@ class TruthMode:
     def noise_weights(self) -> np.ndarray:
         """Expected z^2 per value of each channel under noise alone (fit.Problem.e0)."""
         w = np.ones(len(self.channels()))
-        w[3 * self.trucks :] = 0.0  # censored linkage readings: zero inside the cell
+        if self.has_link:  # censored linkage readings: zero inside the cell
+            n = len(self.channels()) - 3 * self.trucks
+            w[3 * self.trucks :] = self.link_gauss[:n].astype(float)
         return w
+
+    def link_sigma(self) -> np.ndarray:
+        """Per linkage channel: the truth's own noise plus the cell's quantisation where the
+        channel is Gaussian; the quantisation where it is censored."""
+        steps = np.array([self.step_rad, self.step_rad, self.step_l_mm]) / math.sqrt(12.0)
+        return np.where(self.link_gauss, np.hypot(self.link_noise, steps), steps)
 
     def residuals(self, P: dict) -> np.ndarray:
         cols = []
@@ -134,10 +284,18 @@ class TruthMode:
             tl = self.tlink[self.i]
             ba, bb, bl = link_bias(P, tl[:, 0], tl[:, 1])
             m = self.meas[self.i]
-            ra = _censored(tl[:, 0] + math.radians(ba), m[:, 0], self.step_rad, True)
+            g = self.link_gauss
+
+            def res(c: int, x: np.ndarray, step: float, angle: bool) -> np.ndarray:
+                if not g[c]:
+                    return _censored(x, m[:, c], step, angle)
+                d = m[:, c] + 0.5 * step - x  # the cell's centre against the measured truth
+                return wrap_rad(d) if angle else d
+
+            ra = res(0, tl[:, 0] + math.radians(ba), self.step_rad, True)
             if self.robot.vehicle == "clapper":
-                rb = _censored(tl[:, 1] + math.radians(bb), m[:, 1], self.step_rad, True)
-                rl = _censored(tl[:, 2] + bl, m[:, 2], self.step_l_mm, False)
+                rb = res(1, tl[:, 1] + math.radians(bb), self.step_rad, True)
+                rl = res(2, tl[:, 2] + bl, self.step_l_mm, False)
                 cols.append(np.column_stack([ra, rb, rl]))
             else:
                 cols.append(ra[:, None])
@@ -178,7 +336,7 @@ class TruthMode:
         return np.hstack(cols)
 
     def extra_var(self, P: dict) -> np.ndarray | None:
-        h = P.get("roughness.max_height_mm", 0.0)
+        h = max(truck_view(P, t).get("roughness.max_height_mm", 0.0) for t in range(self.trucks))
         if h <= 0:
             return None
         sp = P.get("roughness.spacing_mm", 20.0)
@@ -191,6 +349,9 @@ class TruthMode:
             # each wheel: grains cut by the window's ends count by their share only
             # (model.rough_window_var; without it the variance was ~20 % too high on 0.4 s
             # windows and pulled the height down, an es making up the mean)
+            h = truck_view(P, t).get("roughness.max_height_mm", 0.0)
+            if h <= 0:
+                continue
             m1, _ = rough_moments(self.pr.R[t], h)
             var = np.zeros(self.i.size)
             for w in (0, 1):
@@ -217,9 +378,17 @@ class TruthMode:
         m = self.anchored({}, truck)
         r = self.tpose[:, truck, :] - m
         r[:, 2] = np.unwrap(r[:, 2])
-        dt = np.diff(self.tt)
-        even = np.abs(dt[1:] - dt[:-1]) <= 1e-6 * np.maximum(dt[1:], 1e-9)
-        d2 = (r[2:] - 2.0 * r[1:-1] + r[:-2])[even]
+        # unevenly spaced samples (a truth with timing jitter, or at its own rate): the second
+        # divided difference, scaled so that white noise of variance sigma^2 gives 6 sigma^2 as
+        # the plain second difference of even samples does
+        h1, h2 = np.diff(self.tt)[:-1], np.diff(self.tt)[1:]
+        ok = (h1 > 0) & (h2 > 0)
+        h1, h2 = np.where(ok, h1, 1.0), np.where(ok, h2, 1.0)
+        w0, w2 = 1.0 / h1, 1.0 / h2
+        w1 = w0 + w2
+        d = w2[:, None] * r[2:] - w1[:, None] * r[1:-1] + w0[:, None] * r[:-2]
+        scale = np.sqrt(6.0 / (w0 * w0 + w1 * w1 + w2 * w2))
+        d2 = (d * scale[:, None])[ok]
         return d2[:, :2].ravel(), d2[:, 2]
 
     def stationary(self) -> np.ndarray:
@@ -282,6 +451,9 @@ class ReturnsMode:
 
     def noise_weights(self) -> np.ndarray:
         return np.ones(len(self.channels()))
+
+    def sys_z(self, P: dict, sigma: np.ndarray) -> np.ndarray:
+        return self.residuals(P) / sigma
 
     def gap(self, P: dict) -> float:
         r = self.residuals(P)[0]
@@ -418,6 +590,9 @@ class LinkageMode:
 
     def noise_weights(self) -> np.ndarray:
         return np.ones(len(self.channels()))
+
+    def sys_z(self, P: dict, sigma: np.ndarray) -> np.ndarray:
+        return self.residuals(P) / sigma
 
     def gap(self, P: dict) -> float:
         r = self._pred(P)

@@ -1,5 +1,10 @@
 """libodosim through ctypes (host_sim/include/odosim/odosim.h): the effects catalog for the
-diagnosis, and odosim_run_ex for the blind check's "real" runs."""
+diagnosis, and odosim_run_ex for the blind check's "real" runs.
+
+The ctypes structs below mirror the C ones; `check_layouts` compares their sizes with the
+`sizeof` libodosim exports (odosim_sizeof), and `lib()` refuses a library they do not match, so a
+field added on the C side fails loudly (tests/python/test_gap_hidden.py) instead of shifting every
+later field."""
 
 from __future__ import annotations
 
@@ -116,7 +121,31 @@ def lib() -> C.CDLL:
     ]
     so.odosim_effects_json.restype = C.c_void_p
     so.odosim_free.argtypes = [C.c_void_p]
+    so.odosim_sizeof.restype = C.c_size_t
+    so.odosim_sizeof.argtypes = [C.c_char_p]
+    bad = check_layouts(so)
+    if bad:
+        raise GapInputError(lib_path(), "ctypes layouts do not match libodosim: " + "; ".join(bad))
     return so
+
+
+# the C type each ctypes struct mirrors
+LAYOUTS = {
+    "odosim_tick_row_ex_t": RowEx,
+    "odosim_event_t": Event,
+    "odosim_result_t": Result,
+    "odosim_run_opts_t": Opts,
+}
+
+
+def check_layouts(so: C.CDLL) -> list[str]:
+    """Structs whose ctypes size differs from libodosim's sizeof (empty when all match)."""
+    bad = []
+    for name, cls in LAYOUTS.items():
+        n = int(so.odosim_sizeof(name.encode()))
+        if n != C.sizeof(cls):
+            bad.append(f"{name}: C {n} bytes, ctypes {C.sizeof(cls)}")
+    return bad
 
 
 @lru_cache(maxsize=1)

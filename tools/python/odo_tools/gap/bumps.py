@@ -1,0 +1,199 @@
+"""Discrete bumps (truth mode): locate heading steps in the truth-minus-model heading, fit each
+with the exact rigid-wheel profile (004 Eqs. 1-5, host_sim bump.c `exact`), and cluster the events
+of runs of one path at one wheel travel into floor bumps."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from scipy.optimize import least_squares
+
+from .model import Prepared, bump_dd, bump_excess
+from .paths import group_key
+
+
+def _mad(x: np.ndarray) -> float:
+    """Robust standard deviation (scaled median absolute deviation)."""
+    return float(1.4826 * np.median(np.abs(x - np.median(x))))
+
+
+# ------------------------------------------------------------------------------------------------
+def _signed_excess(
+    pr: Prepared, truck: int, wheel: int, h: float, s0: float, a: int = 0, b: int | None = None
+) -> np.ndarray:
+    """Heading (rad) a bump under (truck, wheel) adds at ticks a..b (up to a constant)."""
+    b = pr.S.shape[0] if b is None else b
+    e = bump_excess(pr.R[truck], h, pr.S[a:b, truck, wheel] - s0)
+    sg = np.sign(pr.ds[a : b - 1, truck, wheel])
+    d = np.concatenate([[0.0], np.cumsum(sg * np.diff(e))])
+    return (d if wheel == 0 else -d) / pr.b[truck]
+
+
+def _step_detector(e: np.ndarray, m: int) -> np.ndarray:
+    """Step estimate at every sample: the step between the m samples either side minus a third
+    of the outer difference, x 1.5: a step's own size at a step, zero for a ramp (drift). The
+    run is continued by its end values, so a bump in a run's first or last second (the last
+    corner of a rectangle) is seen too."""
+    ep = np.pad(e, 2 * m, mode="edge")
+    c = np.concatenate([[0.0], np.cumsum(ep)])
+    k = np.arange(2 * m, ep.size - 2 * m)
+
+    def mean(a, b):
+        return (c[b] - c[a]) / m
+
+    D = (mean(k, k + m) - mean(k - m, k)) - (mean(k + m, k + 2 * m) - mean(k - 2 * m, k - m)) / 3
+    return 1.5 * D
+
+
+def detect_bumps(items: list, P: dict, sigma_head: float) -> list[dict]:
+    """Heading steps in each run's truth-minus-model heading; each refined to (wheel, s0, h)."""
+    events = []
+    for it in items:
+        pr = it.pr
+        for truck in range(it.trucks):
+            mp = it.model_pose(P, truck)
+            e = it.tpose[:, truck, 2] - mp[:, 2]
+            tt = it.tt
+            dt = float(np.median(np.diff(tt)))
+            m = max(3, round(0.5 / dt))
+            if e.size < 4 * m:
+                continue
+            D = _step_detector(e, m)
+            thr = max(8.0 * _mad(D), 6.0 * sigma_head / math.sqrt(m), 2e-4)
+            masked = np.zeros(D.size, dtype=bool)
+            h_grid = np.linspace(0.2, 50.0, 400)
+            dd_grid = bump_dd(pr.R[truck], h_grid)
+            Sa = np.stack([np.interp(tt, pr.t, pr.S[:, truck, w]) for w in (0, 1)])
+            tick_all = np.clip(np.searchsorted(pr.t, tt - 1e-9), 0, pr.t.size - 1)
+            for _ in range(20):
+                absd = np.where(masked, 0.0, np.abs(D))
+                q = int(np.argmax(absd))
+                if absd[q] < thr:
+                    break
+                masked[max(0, q - 2 * m) : q + 2 * m] = True
+                kc = q
+                lo, hi = max(0, kc - 2 * m), min(e.size - 1, kc + 2 * m)
+                best = None
+                # a bump under the left wheel turns the truck left while that wheel rolls
+                # forward (_signed_excess): where both wheels roll one way the step's sign names
+                # the wheel, and its size the height (one start instead of two per wheel)
+                tick = int(np.clip(np.searchsorted(pr.t, tt[kc]), 1, pr.ds.shape[0])) - 1
+                roll = np.sign(pr.ds[tick, truck, :])
+                wheels = [w for w in (0, 1) if (1 if w == 0 else -1) * roll[w] == np.sign(D[q])]
+                if roll[0] != roll[1] or not wheels:
+                    wheels = [0, 1]
+                h0 = float(np.interp(abs(D[q]) * pr.b[truck], dd_grid, h_grid))
+                for w in wheels:
+                    s_lo, s_hi = Sa[w, lo], Sa[w, hi]
+                    if s_hi - s_lo < 20.0:
+                        continue
+                    idx = np.arange(lo, hi + 1)
+                    tick_idx = np.searchsorted(pr.t, tt[idx] - 1e-9)
+                    tick_idx = np.clip(tick_idx, 0, pr.t.size - 1)
+                    ta, tb = int(tick_idx[0]), int(tick_idx[-1]) + 1
+                    ti_loc = tick_idx - ta
+                    # offset and slope of the drift under the step enter linearly: projected
+                    # out (variable projection), the fit moves only height and position
+                    tau = tt[idx] - tt[kc]
+                    Q, _ = np.linalg.qr(np.column_stack([np.ones_like(tau), tau]))
+                    y0 = e[idx]
+
+                    def res(x, pr=pr, w=w, ti=ti_loc, truck=truck, ta=ta, tb=tb, Q=Q, y0=y0):
+                        y = y0 - _signed_excess(pr, truck, w, x[0], x[1], ta, tb)[ti]
+                        return (y - Q @ (Q.T @ y)) / 1e-4
+
+                    s_mid = Sa[w, kc]
+                    try:
+                        r = least_squares(
+                            res,
+                            [h0, s_mid - 30.0],
+                            bounds=([0.2, s_lo - 100], [50.0, s_hi]),
+                            max_nfev=80,
+                        )
+                    except ValueError:
+                        continue
+                    if best is None or r.cost < best[0]:
+                        best = (r.cost, w, r.x)
+                if best is None:
+                    continue
+                _, w, x = best
+                # take the event out of the residual before looking for the next: the detector
+                # answers a step with opposite side lobes of a third of it, and a big bump's ramp
+                # carries them past the mask (spurious "bumps" on the other wheel ~1.2 s later)
+                e = e - _signed_excess(pr, truck, w, x[0], x[1])[tick_all]
+                D = _step_detector(e, m)
+                j = int(np.clip(np.searchsorted(Sa[w], x[1]), 0, tt.size - 1))
+                th = it.tpose[j, truck, 2]
+                half = (0.5 if w == 0 else -0.5) * pr.b[truck]
+                xy = (
+                    it.tpose[j, truck, 0] - half * math.sin(th),
+                    it.tpose[j, truck, 1] + half * math.cos(th),
+                )
+                events.append(
+                    {
+                        "run": pr.run.name,
+                        "group": group_key(pr),
+                        "truck": truck,
+                        "wheel": w,
+                        "s0": float(x[1]),
+                        "h": float(x[0]),
+                        "t_s": float(tt[j]),
+                        "x_mm": float(xy[0]),
+                        "y_mm": float(xy[1]),
+                    }
+                )
+    return events
+
+
+def cluster_bumps(events: list[dict], tol_mm: float = 80.0) -> list[dict]:
+    """Events of runs on the same path at the same wheel travel are one floor bump."""
+    out = []
+    keyf = lambda e: (e["group"], e["truck"], e["wheel"])  # noqa: E731
+    for key in sorted({keyf(e) for e in events}):
+        evs = sorted((e for e in events if keyf(e) == key), key=lambda e: e["s0"])
+        cur: list[dict] = []
+        for e in [*evs, None]:
+            if e is not None and (not cur or e["s0"] - cur[-1]["s0"] < tol_mm):
+                cur.append(e)
+                continue
+            if cur:
+                out.append(
+                    {
+                        "group": key[0],
+                        "truck": key[1],
+                        "wheel": key[2],
+                        "s0": float(np.median([c["s0"] for c in cur])),
+                        "h": float(np.median([c["h"] for c in cur])),
+                        "x_mm": float(np.median([c["x_mm"] for c in cur])),
+                        "y_mm": float(np.median([c["y_mm"] for c in cur])),
+                        "t_s": float(np.median([c["t_s"] for c in cur])),
+                        "runs": sorted({c["run"] for c in cur}),
+                    }
+                )
+            cur = [e] if e is not None else []
+    return out
+
+
+def place_bumps(
+    prs: list[Prepared], floor_bumps: list[dict], h: float | None = None, own: bool = False
+) -> None:
+    """Put floor bumps on the runs of their path; `own`: only on the runs whose own events made
+    them (fitting: a path's runs need not share their bumps - rect-7x4 alternates the wheel)."""
+    for pr in prs:
+        g = group_key(pr)
+        pr.bumps = [
+            {
+                "truck": b["truck"],
+                "wheel": b["wheel"],
+                "s0": b["s0"],
+                "h": h if h is not None else b["h"],
+            }
+            for b in floor_bumps
+            if b["group"] == g and (not own or pr.run.name in b.get("runs", ()))
+        ]
+
+
+def clear_bumps(prs: list[Prepared]) -> None:
+    for pr in prs:
+        pr.bumps = []

@@ -1,0 +1,191 @@
+"""How far the gap shrinks on runs held out from every fit, in absolute terms against the measured
+background (issue 13 item 2).
+
+Per held-out run and per model (nominal, and with the candidate effect): the gap a person reads
+(truth: RMS position error of truck A along the run in mm and RMS heading error in deg; returns:
+the return position error in mm and heading in deg; linkage: the linkage prediction error), and
+the background allowance beside it (what the measured floor walk and the truth's noise alone
+would leave on that run). The standardised residuals z (error / sqrt(noise + background
+variance); truth: each truck's accumulated x, y and heading error once per window, plus the
+linkage readings) give the **misfit ratio** R = sqrt(mean z^2): 1 is "nothing but background",
+and the verdict reads R before and after (diagnose.decide). The systematic gap
+G = sqrt(max(R^2 - 1, 2 sqrt(2/n))) is the misfit in excess of the background, floored at twice
+the standard error of mean z^2 under background alone; shrink = G before / G after, 95 % CI by
+bootstrap over the held-out runs.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .background import Background
+from .bumps import clear_bumps, place_bumps
+from .fit import Fit
+from .modes import TruthMode, wrap_rad
+
+HELDOUT_BUMP_MIN_RUNS = 2
+
+
+def apply(f: Fit | None, prs: list, min_runs: int = 1) -> dict:
+    """Put the fit's effect on runs; `min_runs`: place only floor bumps seen in that many fitting
+    runs. Held-out runs use 2: a bump found in one run only may belong to that run (rect-7x4 lays
+    its bumps under alternating wheels from run to run), and predicting it where it is not adds
+    a heading step the held-out run never had; a bump two runs of the path agree on is a floor
+    feature."""
+    clear_bumps(prs)
+    if f is None:
+        return {}
+    if f.bumps:
+        place_bumps(prs, [b for b in f.bumps if len(b.get("runs", [])) >= min_runs])
+    return f.model_params()
+
+
+@dataclass
+class RunGap:
+    run: str
+    mm: float  # the gap a person reads (module doc)
+    deg: float
+    z2: float  # sum of squared standardised residuals
+    n: int
+    end_mm: float = 0.0  # the return error: position error at the run's end (truth, returns)
+    end_deg: float = 0.0
+
+
+@dataclass
+class HeldOut:
+    runs: list[str]
+    before: list[RunGap]
+    after: list[RunGap]
+    background_mm: list[float]
+    background_deg: list[float]
+    ratio_before: float = 0.0
+    ratio_after: float = 0.0
+    gap_before: float = 0.0
+    gap_after: float = 0.0
+    shrink: float = 1.0
+    shrink_ci: tuple[float, float] = (1.0, 1.0)
+    extra: dict = field(default_factory=dict)
+
+    @property
+    def mm_before(self) -> float:
+        return float(np.mean([g.mm for g in self.before]))
+
+    @property
+    def mm_after(self) -> float:
+        return float(np.mean([g.mm for g in self.after]))
+
+    @property
+    def deg_before(self) -> float:
+        return float(np.mean([g.deg for g in self.before]))
+
+    @property
+    def deg_after(self) -> float:
+        return float(np.mean([g.deg for g in self.after]))
+
+    @property
+    def end_mm_before(self) -> float:
+        return float(np.mean([g.end_mm for g in self.before]))
+
+    @property
+    def end_mm_after(self) -> float:
+        return float(np.mean([g.end_mm for g in self.after]))
+
+    @property
+    def bg_mm(self) -> float:
+        return float(np.mean(self.background_mm))
+
+    @property
+    def bg_deg(self) -> float:
+        return float(np.mean(self.background_deg))
+
+
+def run_gap(item, P: dict, sigma: np.ndarray, bg: Background) -> tuple[RunGap, float, float]:
+    """(gap of one run under P, background allowance in mm and deg)."""
+    name = item.pr.run.name
+    if isinstance(item, TruthMode):
+        zs, mm, deg = [], 0.0, 0.0
+        bmm, bdeg = 0.0, 0.0
+        for t in range(item.trucks):
+            m = item.anchored(P, t)[item.i]
+            e = m - item.tpose[item.i, t]
+            e[:, 2] = wrap_rad(e[:, 2])
+            s_pos = sigma[3 * t] / math.sqrt(2.0)
+            s_head = sigma[3 * t + 2] / math.sqrt(2.0)
+            tv = bg.track_var(item, t)
+            var = np.column_stack([s_pos**2 + tv[:, 0], s_pos**2 + tv[:, 1], s_head**2 + tv[:, 2]])
+            zs.append(e / np.sqrt(var))
+            if t == 0:
+                mm = float(np.sqrt(np.mean(e[:, 0] ** 2 + e[:, 1] ** 2)))
+                deg = float(np.degrees(np.sqrt(np.mean(e[:, 2] ** 2))))
+                last = item.anchored(P, 0)[-1] - item.tpose[-1, 0]
+                end = (float(np.hypot(last[0], last[1])), float(abs(np.degrees(wrap_rad(last[2])))))
+                bmm = float(np.sqrt(np.mean(var[:, 0] + var[:, 1])))
+                bdeg = float(np.degrees(np.sqrt(np.mean(var[:, 2]))))
+        if item.has_link:
+            k = 3 * item.trucks
+            zs.append(item.residuals(P)[:, k:] / sigma[k:])
+        z = np.hstack(zs)
+        return RunGap(name, mm, deg, float(np.sum(z * z)), int(z.size), *end), bmm, bdeg
+    r = item.residuals(P)
+    z = item.sys_z(P, sigma)
+    if item.name == "returns":
+        mm = float(math.hypot(r[0, 0], r[0, 1]))
+        deg = float(abs(math.degrees(r[0, 2])))
+        bmm = float(math.hypot(sigma[0], sigma[1]))
+        bdeg = float(math.degrees(sigma[2]))
+    else:
+        mm = item.gap(P)
+        deg = float(np.degrees(np.sqrt(np.mean(r[:, 0] ** 2))))
+        L = item.robot.linkage.get("length_mm", 1000.0)
+        bmm = float(np.sqrt(np.sum((sigma * np.array([L, L, 1.0])[: sigma.size]) ** 2)))
+        bdeg = float(np.degrees(sigma[0]))
+    end = (mm, deg) if item.name == "returns" else (0.0, 0.0)
+    return RunGap(name, mm, deg, float(np.sum(z * z)), int(z.size), *end), bmm, bdeg
+
+
+def _ratio(z2: np.ndarray, n: np.ndarray) -> float:
+    return float(math.sqrt(float(np.sum(z2)) / max(float(np.sum(n)), 1.0)))
+
+
+def _sysgap(z2: np.ndarray, n: np.ndarray) -> float:
+    N = max(float(np.sum(n)), 1.0)
+    return float(math.sqrt(max(float(np.sum(z2)) / N - 1.0, 2.0 * math.sqrt(2.0 / N))))
+
+
+def evaluate(
+    items: list,
+    prs: list,
+    held: list[int],
+    f: Fit | None,
+    sigma: np.ndarray,
+    bg: Background,
+    seed: int = 1,
+    boot: int = 1000,
+) -> HeldOut:
+    """Before (nominal) and after (`f`, None = nominal) on the held-out runs."""
+    hprs = [prs[i] for i in held]
+    P = apply(f, hprs, HELDOUT_BUMP_MIN_RUNS)
+    after = [run_gap(items[i], P, sigma, bg)[0] for i in held]
+    clear_bumps(hprs)
+    res = [run_gap(items[i], {}, sigma, bg) for i in held]
+    before = [r[0] for r in res]
+    out = HeldOut(
+        [prs[i].run.name for i in held], before, after, [r[1] for r in res], [r[2] for r in res]
+    )
+    zb = np.array([g.z2 for g in before])
+    za = np.array([g.z2 for g in after])
+    nn = np.array([g.n for g in before])
+    out.ratio_before, out.ratio_after = _ratio(zb, nn), _ratio(za, nn)
+    out.gap_before, out.gap_after = _sysgap(zb, nn), _sysgap(za, nn)
+    out.shrink = out.gap_before / out.gap_after
+    rng = np.random.default_rng(seed)
+    bs = []
+    for _ in range(boot):
+        s = rng.integers(0, len(held), len(held))
+        bs.append(_sysgap(zb[s], nn[s]) / _sysgap(za[s], nn[s]))
+    if bs:
+        out.shrink_ci = (float(np.percentile(bs, 2.5)), float(np.percentile(bs, 97.5)))
+    return out

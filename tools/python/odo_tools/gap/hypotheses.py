@@ -1,0 +1,206 @@
+"""Hypotheses: which effects, under which laws, with which free parameters.
+
+Every catalog effect the evidence mode can see (catalog.hypotheses) is a hypothesis under its
+catalog law. Some physics come in more than one law in the real world (issue 13 item 3): slip
+tied to the acceleration or to traction (torque) saturation, counts lost above a speed. Those
+laws are hypotheses of the same family, proposed when the residual lives where that physics acts
+(`propose`: slip in the accelerating phases, count loss at high wheel speed); the verdict names
+the family (the physics) and reports the law that fitted. Pairs join two families.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from . import catalog
+
+# free parameters of each catalog effect under its catalog law (others stay at their defaults)
+CATALOG_FREE = {
+    "ed": ("value",),
+    "eb": ("value",),
+    "es": ("value",),
+    "roughness": (),  # its height follows from the measured walk (fit.Problem.rough_from_walk)
+    "slip": ("k_per_m_s2", "tau_s"),
+    "skid": ("k_s",),
+    "rotary_bias": ("alpha_deg", "beta_deg"),
+    "link_bias": ("const_mm", "ecc_mm"),
+    "scrub": ("k",),
+}
+
+# parameters that are not catalog parameters: model-side nuisances and the other laws' own
+# (min, max, start)
+EXTRA_BOUNDS = {
+    "slip.tau_s": (0.0005, 0.02, 0.004),
+    "slip@accel.k_per_m_s2": (0.0, 5.0, 0.05),
+    "slip@accel.a0_m_s2": (0.0, 5.0, 0.2),
+    "slip@traction.a_max_m_s2": (0.05, 20.0, 2.0),
+    "count_loss@speed.k_per_m_s": (0.0, 20.0, 0.2),
+    "count_loss@speed.v0_mm_s": (0.0, 5000.0, 300.0),
+}
+START = {"slip.k_per_m_s2": 0.05, "skid.k_s": 0.05, "roughness.max_height_mm": 0.5}
+
+
+@dataclass(frozen=True)
+class Law:
+    family: str  # the catalog effect whose physics it is ("slip")
+    name: str  # "catalog", "acceleration", "traction", "above a speed"
+    params: tuple[str, ...]  # fitted keys
+    doc: str
+    truck: str | None = None  # "A" or "B": on that truck only (model.truck_view)
+
+    @property
+    def key(self) -> str:
+        """How the hypothesis is named in rankings: 'slip', 'slip@traction', 'ed[B]'."""
+        k = self.family if self.name == "catalog" else f"{self.family}@{self.name}"
+        return k if self.truck is None else f"{k}[{self.truck}]"
+
+    def on(self, truck: str) -> Law:
+        """The same law on one truck of a clapper or set."""
+        return Law(
+            self.family, self.name, tuple(f"{p}.{truck}" for p in self.params), self.doc, truck
+        )
+
+
+def catalog_law(effect: str, vehicle: str) -> Law:
+    free = CATALOG_FREE.get(effect, ())
+    if effect == "rotary_bias" and vehicle == "set":
+        free = ("alpha_deg",)  # a set has one joint encoder
+    doc = catalog.effects()[effect]["doc"]
+    return Law(effect, "catalog", tuple(f"{effect}.{p}" for p in free), doc)
+
+
+# the other laws of a family (model.py implements each)
+OTHER_LAWS = {
+    "slip": (
+        Law(
+            "slip",
+            "accel",
+            ("slip@accel.k_per_m_s2", "slip@accel.a0_m_s2"),
+            "slip fraction k max(0, |a| - a0) on the acceleration the counts show, tick by tick",
+        ),
+        Law(
+            "slip",
+            "traction",
+            ("slip@traction.a_max_m_s2",),
+            "traction (torque) saturation: the floor speed follows the wheel at most a_max",
+        ),
+    ),
+    "count_loss": (
+        Law(
+            "count_loss",
+            "speed",
+            ("count_loss@speed.k_per_m_s", "count_loss@speed.v0_mm_s"),
+            "a fraction k max(0, |v| - v0) of the travel never reaches the counter",
+        ),
+    ),
+}
+
+# the catalog count_loss acts through the decoder's clock (an HCTL filter), which the counts do
+# not show: its hypothesis is the generic law above
+CATALOG_LAW_REPLACED = {"count_loss": "speed"}
+
+
+@dataclass(frozen=True)
+class Hypothesis:
+    laws: tuple[Law, ...]
+
+    @property
+    def name(self) -> str:
+        """'ed', 'slip@traction', 'eb+scrub': families with their law where not the catalog's,
+        bumps last."""
+        keys = sorted((law.key for law in self.laws), key=lambda k: (k == "bumps", k))
+        return "+".join(keys)
+
+    @property
+    def families(self) -> tuple[str, ...]:
+        return tuple(sorted({law.family for law in self.laws}))
+
+    @property
+    def label(self) -> str:
+        """What the verdict names: the physics, whatever the law ('slip', 'ed+slip')."""
+        return "+".join(self.families)
+
+    @property
+    def params(self) -> list[str]:
+        return [p for law in self.laws for p in law.params]
+
+    @property
+    def has_bumps(self) -> bool:
+        return any(law.family == "bumps" for law in self.laws)
+
+    def __add__(self, other: Hypothesis) -> Hypothesis:
+        return Hypothesis(self.laws + other.laws)
+
+
+def singles(mode: str, vehicle: str) -> list[Hypothesis]:
+    """One hypothesis per catalog effect the mode sees, under its catalog law (count loss under
+    the law the counts can show)."""
+    out = []
+    for e in catalog.hypotheses(mode, vehicle):
+        if e in CATALOG_LAW_REPLACED:
+            name = CATALOG_LAW_REPLACED[e]
+            law = next(x for x in OTHER_LAWS[e] if x.name == name)
+            out.append(Hypothesis((law,)))
+        else:
+            out.append(Hypothesis((catalog_law(e, vehicle),)))
+    return out
+
+
+def other_laws(family: str, mode: str, vehicle: str) -> list[Hypothesis]:
+    """The other laws of a family, when the family is a hypothesis of this mode."""
+    if family not in catalog.hypotheses(mode, vehicle):
+        return []
+    skip = CATALOG_LAW_REPLACED.get(family)
+    return [Hypothesis((law,)) for law in OTHER_LAWS.get(family, ()) if law.name != skip]
+
+
+def on_truck(h: Hypothesis, truck: str) -> Hypothesis | None:
+    """A single hypothesis of a truck-scoped effect restricted to one truck (None otherwise)."""
+    if len(h.laws) != 1 or h.has_bumps:
+        return None
+    law = h.laws[0]
+    if law.truck is not None or catalog.effects()[law.family]["scope"] != "truck":
+        return None
+    if law.family == "roughness":  # one floor under both trucks
+        return None
+    return Hypothesis((law.on(truck),))
+
+
+TRUCK_SHARE = 0.75  # a truck holding this share of the excess misfit proposes its own variants
+
+
+def bounds(key: str) -> tuple[float, float, float]:
+    """(min, max, start) of a fitted parameter: the catalog's range, or EXTRA_BOUNDS (a truck's
+    own copy, 'ed.value.B', has the bounds of 'ed.value')."""
+    if key.endswith((".A", ".B")):
+        key = key[:-2]
+    if key in EXTRA_BOUNDS:
+        return EXTRA_BOUNDS[key]
+    lo, hi, d = catalog.bounds(key)
+    return lo, hi, START.get(key, d)
+
+
+# where the residual lives -> which families to test with their other laws (where.phase_excess)
+PROPOSE = {
+    "slip": ("acceleration",),
+    "count_loss": ("fast",),
+}
+PROPOSE_SHARE = 0.25  # a phase holding this share of the excess misfit proposes its families
+PROPOSE_DENSITY = 2.0  # ... or this many times its share of the run
+
+
+def propose(phase_excess: dict[str, tuple[float, float]]) -> dict[str, str]:
+    """Families whose physics acts where the residual lives, with the evidence in words.
+    `phase_excess`: phase -> (share of the nominal excess misfit, share of the windows)."""
+    out = {}
+    for fam, phases in PROPOSE.items():
+        for ph in phases:
+            share, frac = phase_excess.get(ph, (0.0, 0.0))
+            if share >= PROPOSE_SHARE or (
+                frac > 0 and share >= PROPOSE_DENSITY * frac and share > 0.05
+            ):
+                out[fam] = (
+                    f"{share:.0%} of the excess misfit lies in the {ph} phases "
+                    f"({frac:.0%} of the run)"
+                )
+    return out

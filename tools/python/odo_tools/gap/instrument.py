@@ -1,0 +1,262 @@
+"""Nuisances of a truth track, estimated from the data before any hypothesis is fitted.
+
+A motion-capture track is not the axle centre at the robot's clock: the marker sits somewhere on
+the body (a lever arm of up to a few cm), and the two clocks are offset (latency, often different
+per run). Both move the truth in ways no catalog effect should be asked to explain:
+
+- **Lever arm** (per truck, x forward and y left of the axle centre): on a turn on the spot the
+  centre stays put while the marker circles it, so the marker's increments there are
+  (R(dtheta) - I) o, linear in o, with the measured heading change. Fitted on those windows only
+  (on arcs an Eb or a scrub misfit is correlated with it); without spot turns it is left at zero
+  and the report says so.
+- **Latency** (per run): the time shift that best lines the truth's heading and travel
+  increments up with the nominal model's, kept where it lowers the misfit beyond chance
+  (Delta chi^2 25); a run that does not fix it (a spin) takes its session's median. A session
+  whose runs disagree (beyond a third of their median or a quarter tick) keeps only latencies of
+  1.5 ticks or more: slip on a turn's start mimics a latency that varies with how hard each path
+  accelerates (the simulator's slip read 12 ms on UMBmark and 25 ms on rect-7x4); a clock
+  offset is the same on every run (the independent world's 22-25 ms).
+
+The OptiOdom circles carry ~0.1-0.3 s of latency between mocap and wheel counts (their heading
+misfit follows the turn rate), the squares ~25 ms; the lever arm of its marker is ~1-2 cm.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .model import Prepared, dead_reckon
+from .modes import WINDOW_S, Instrument, _body_inc, to_centre
+
+LATENCY_MAX_S = 0.5
+LATENCY_STEP_S = 0.005
+LATENCY_DCHI2 = 25.0  # a shift must lower the misfit by this much (in noise units)
+LEVER_MIN_WINDOWS = 10
+LEVER_SIGNIFICANT = 3.0  # |o| in standard errors below which the lever arm is left at zero
+SPOT_TURN_RAD = 0.05  # a window turning at least this much ...
+SPOT_TRAVEL = 0.1  # ... while its centre moves less than this x (b/2) x |dtheta|
+TURN_RAD = 0.02  # without spot turns: every window that turns this much (arcs of both ways)
+
+
+def estimate(prs: list[Prepared], trucks: int) -> tuple[Instrument, list[str]]:
+    """(instrument, notes for the report) from the runs that have a truth track. The latency
+    and the lever arm are estimated in turn, twice: each blurs the other (the independent
+    world's 25 mm marker left its 27 ms latency within the 10 % a shift must gain)."""
+    inst = Instrument(lever_mm=[(0.0, 0.0)] * trucks, lever_se_mm=[(0.0, 0.0)] * trucks)
+    with_truth = [pr for pr in prs if pr.run.truth is not None]
+    for _ in range(2):
+        notes = []
+        found = {pr.run.name: latency(pr, lever=inst.lever_mm[0]) for pr in with_truth}
+        inst.latency_s.update(session_latencies(with_truth, found))
+        for t in range(trucks):
+            o, se, n = lever_arm(with_truth, t, inst)
+            if o is None:
+                notes.append(
+                    f"truck {'AB'[t]}: lever arm of the tracked point not estimated ({n} "
+                    "windows turning on the spot; needs 10): taken as zero"
+                )
+                continue
+            inst.lever_se_mm[t] = se
+            inst.lever_mm[t] = o if significant(o, se) else (0.0, 0.0)
+    return inst, notes
+
+
+def under(inst: Instrument, prs: list[Prepared], P: dict) -> Instrument:
+    """The instrument with each run's latency estimated again under a candidate P, without the
+    half-tick floor: once the candidate takes its own share of the heading misfit where the rate
+    changes (slip does; a kinematic effect does not), what is left of a shift is the clock. The
+    OptiOdom squares' ~25 ms, half their 50 ms tick, read as the truth's noise otherwise."""
+    out = Instrument(list(inst.lever_mm), list(inst.lever_se_mm), dict(inst.latency_s))
+    with_truth = [pr for pr in prs if pr.run.truth is not None]
+    found = {
+        pr.run.name: latency(pr, 0, P, min_tick=0.0, lever=inst.lever_mm[0]) for pr in with_truth
+    }
+    out.latency_s.update(session_latencies(with_truth, found))
+    return out
+
+
+def on_arcs(
+    inst: Instrument, prs: list[Prepared], truck: int, P: dict
+) -> tuple[tuple[float, float] | None, tuple[float, float], int]:
+    """The lever arm where the robot never turns on the spot: on arcs of both directions, under a
+    candidate P for the robot's geometry (the caller's preliminary kinematic fit). On an arc the
+    marker's increments differ from the centre's by (R(dtheta) - I) o: a forward offset moves
+    them sideways, a sideways one along - with arcs of both directions neither is a scale error
+    or a skid. Without it the independent world's 30 mm markers read as roughness at its bound."""
+    with_truth = [pr for pr in prs if pr.run.truth is not None]
+    return lever_arm(with_truth, truck, inst, P, arcs=True)
+
+
+def significant(o, se) -> bool:
+    z = math.hypot(o[0] / max(se[0], 1e-9), o[1] / max(se[1], 1e-9))
+    return z >= LEVER_SIGNIFICANT and math.hypot(*o) >= 1.0
+
+
+def _windows(tt: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    dt = float(np.median(np.diff(tt)))
+    W = max(1, round(WINDOW_S / dt))
+    i = np.arange(0, tt.size - W, W)
+    return i, i + W
+
+
+def _mad(x: np.ndarray) -> float:
+    return float(1.4826 * np.median(np.abs(x - np.median(x)))) if x.size else 0.0
+
+
+def latency(
+    pr: Prepared,
+    truck: int = 0,
+    P: dict | None = None,
+    min_tick: float = 0.0,
+    lever: tuple[float, float] = (0.0, 0.0),
+) -> float | None:
+    """The shift (s) that best lines the truth's heading (times half the wheelbase) and travel
+    increments over 0.4 s windows up with the model's (P, nominal by default); None when no
+    shift helps beyond chance (Delta chi^2 25: the session's other runs decide,
+    `session_latencies`), 0 when it is shorter than `min_tick` count ticks. Windows, not the
+    accumulated track: a strong effect (a scrub, slip) leaves a track misfit that a time shift
+    of 0.2 s lowers too (tried: the blind check's simulator, which has no latency, read 0.2 s)."""
+    tr = pr.run.truth
+    p = dead_reckon(pr, P or {}, truck)
+    tt = tr.t_s
+    i, j = _windows(tt)
+    if i.size < 10:
+        return None
+    tp = to_centre(tr.pose[:, truck : truck + 1], [lever])[:, 0]
+    half_b = 0.5 * pr.b[truck]
+    dth = tp[j, 2] - tp[i, 2]
+    c, s_ = np.cos(tp[i, 2]), np.sin(tp[i, 2])
+    dlong = c * (tp[j, 0] - tp[i, 0]) + s_ * (tp[j, 1] - tp[i, 1])
+
+    def resid(L: float) -> np.ndarray:
+        tm = tt - L
+        ok = (tm[i] >= pr.t[0]) & (tm[j] <= pr.t[-1])
+        m = np.column_stack([np.interp(tm, pr.t, p[:, k]) for k in range(3)])
+        cm, sm = np.cos(m[i, 2]), np.sin(m[i, 2])
+        ml = cm * (m[j, 0] - m[i, 0]) + sm * (m[j, 1] - m[i, 1])
+        r = np.concatenate([(dth - (m[j, 2] - m[i, 2])) * half_b, dlong - ml])
+        return np.where(np.concatenate([ok, ok]), r, np.nan)
+
+    grid = np.arange(-LATENCY_MAX_S, LATENCY_MAX_S + 1e-9, LATENCY_STEP_S)
+    R = np.array([resid(L) for L in grid])
+    usable = np.all(np.isfinite(R), axis=0)
+    if usable.sum() < 10:
+        return None
+    R = R[:, usable]
+    cost = np.sum(R * R, axis=1)
+    k0 = int(np.argmin(np.abs(grid)))
+    k = int(np.argmin(cost))
+    if k in (0, grid.size - 1):  # no minimum inside the grid
+        return None
+    s = _mad(np.diff(R[k])) / math.sqrt(2.0)
+    if not s > 0 or (cost[k0] - cost[k]) / (s * s) < LATENCY_DCHI2:
+        return None
+    L = float(grid[k])
+    if abs(L) < min_tick * float(np.median(pr.dt)):
+        return 0.0
+    c0, c1, c2 = cost[k - 1], cost[k], cost[k + 1]  # parabola through the three best
+    den = c0 - 2 * c1 + c2
+    if den > 0:
+        L += float(0.5 * (c0 - c2) / den * LATENCY_STEP_S)
+    return L
+
+
+def one_clock(prs: list[Prepared], lat: dict[str, float]) -> dict[str, bool]:
+    """Per session: whether its runs' latencies look like one clock offset - within a third of
+    their median of each other, or a quarter tick. Slip taken for latency varies with how hard
+    each path accelerates (the simulator's slip read 12 ms on UMBmark, 25 ms on rect-7x4)."""
+    by: dict[str, list[float]] = {}
+    for pr in prs:
+        if pr.run.name in lat:
+            by.setdefault(pr.run.session, []).append(lat[pr.run.name])
+    tick = float(np.median([float(np.median(pr.dt)) for pr in prs])) if prs else 0.0
+    out = {}
+    for sess, vals in by.items():
+        v = np.array(vals)
+        out[sess] = bool(np.ptp(v) <= max(abs(float(np.median(v))) / 3.0, 0.25 * tick))
+    return out
+
+
+CLOCK_TICKS = 1.5  # a latency this many ticks long is the rig's, whatever the session's spread
+
+
+def session_latencies(prs: list[Prepared], found: dict[str, float | None]) -> dict[str, float]:
+    """A run whose track does not fix its latency (a spin, a run an effect dominates) takes the
+    median of its session's runs that do: the clock offset is the rig's (the independent
+    world's squares with slip said nothing, its circles 30-37 ms, a spin 0.5 s at the grid's
+    edge)."""
+    out = {}
+    for pr in prs:
+        name = pr.run.name
+        if found.get(name) is not None:
+            out[name] = float(found[name])
+            continue
+        same = [found[p.run.name] for p in prs if p.run.session == pr.run.session]
+        valid = [x for x in same if x is not None]
+        out[name] = float(np.median(valid)) if valid else 0.0
+    # a session whose runs disagree keeps only the latencies too long for an effect to fake
+    clock = one_clock(prs, out)
+    for pr in prs:
+        L = out[pr.run.name]
+        if not clock.get(pr.run.session, True) and abs(L) < CLOCK_TICKS * float(np.median(pr.dt)):
+            out[pr.run.name] = 0.0
+    return out
+
+
+def lever_arm(
+    prs: list[Prepared], truck: int, inst: Instrument, P: dict | None = None, arcs: bool = False
+) -> tuple[tuple[float, float] | None, tuple[float, float], int]:
+    """Least squares of the marker's increments on spot turns (or, with `arcs`, on every window
+    that turns at least TURN_RAD, the model under P): ((ox, oy), (se_x, se_y), windows)."""
+    A_rows, r_rows = [], []
+    for pr in prs:
+        tr = pr.run.truth
+        if truck >= tr.pose.shape[1]:
+            continue
+        tt = tr.t_s - inst.latency_s.get(pr.run.name, 0.0)
+        i, j = _windows(tt)
+        ok = (tt[i] >= pr.t[0]) & (tt[j] <= pr.t[-1])
+        i, j = i[ok], j[ok]
+        if i.size == 0:
+            continue
+        p = dead_reckon(pr, P or {}, truck)
+        m = np.column_stack([np.interp(tt, pr.t, p[:, k]) for k in range(3)])
+        inc_t = _body_inc(tr.pose[:, truck], i, j)
+        inc_m = _body_inc(m, i, j)
+        dth = inc_t[:, 2]
+        travel = np.hypot(inc_m[:, 0], inc_m[:, 1])
+        if arcs:
+            spot = np.abs(dth) >= TURN_RAD
+        else:
+            spot = (np.abs(dth) >= SPOT_TURN_RAD) & (
+                travel < SPOT_TRAVEL * 0.5 * pr.b[truck] * np.abs(dth)
+            )
+        if not spot.any():
+            continue
+        c, s_ = np.cos(dth[spot]), np.sin(dth[spot])
+        # (R(dtheta) - I) o, rows for x and y
+        A = np.stack(
+            [np.column_stack([c - 1.0, -s_]), np.column_stack([s_, c - 1.0])], axis=1
+        ).reshape(-1, 2)
+        r = (inc_t[spot, :2] - inc_m[spot, :2]).reshape(-1)
+        A_rows.append(A)
+        r_rows.append(r)
+    n = sum(a.shape[0] // 2 for a in A_rows)
+    if n < LEVER_MIN_WINDOWS:
+        return None, (0.0, 0.0), n
+    A, r = np.vstack(A_rows), np.concatenate(r_rows)
+    w = np.ones(r.size)
+    o = np.zeros(2)
+    for _ in range(5):  # Huber-weighted: a bump on a turn must not pull the marker around
+        Aw = A * w[:, None]
+        o = np.linalg.lstsq(Aw, r * w, rcond=None)[0]
+        e = r - A @ o
+        s = max(_mad(e), 1e-6)
+        w = np.sqrt(np.minimum(1.0, 1.5 * s / np.maximum(np.abs(e), 1e-12)))
+    e = r - A @ o
+    s2 = float(np.sum((w * e) ** 2) / max(r.size - 2, 1))
+    cov = np.linalg.pinv((A * w[:, None]).T @ (A * w[:, None])) * s2
+    se = (float(math.sqrt(max(cov[0, 0], 0.0))), float(math.sqrt(max(cov[1, 1], 0.0))))
+    return (float(o[0]), float(o[1])), se, n

@@ -1,0 +1,47 @@
+"""The verdict rule (issue 13 item 2): decided on the held-out runs, in absolute terms against the
+background the data carry (heldout.py: R = RMS misfit in units of that background, 1 = nothing
+but background). Stated once here; report.json repeats the thresholds it used."""
+
+from __future__ import annotations
+
+from .fit import DBIC_SIGNIFICANT
+from .heldout import HeldOut
+
+# the verdict, on the held-out runs (heldout.py: R = RMS misfit in units of the background)
+R_GAP = 2.0  # nominal misfit at least twice the background: a gap
+R_GAP_WITH_BIC = R_GAP  # the fitting runs' Delta BIC alone never makes a gap: with thousands of
+# windows it finds something in every real recording (the independent world's no-effect clapper)
+R_WITHIN = 1.5  # after the fit, within 1.5 x the background: the effect is named
+EXCESS_REMOVED = 0.75  # ... or it removes this share of the held-out misfit above background
+
+
+def decide(held: HeldOut, dbic: float, label: str) -> tuple[str, str]:
+    """The verdict from the held-out misfit ratios R (heldout.py) in words."""
+    r0, r1 = held.ratio_before, held.ratio_after
+    excess0, excess1 = r0 * r0 - 1.0, r1 * r1 - 1.0
+    removed = 1.0 - excess1 / excess0 if excess0 > 0 else 0.0
+    if not (r0 >= R_GAP or (dbic >= DBIC_SIGNIFICANT and r0 >= R_GAP_WITH_BIC)):
+        return "no significant gap", (
+            f"the nominal model's held-out misfit is {r0:.2f} x the background (a gap needs "
+            f"{R_GAP:g} x, or {R_GAP_WITH_BIC:g} x with Delta BIC >= {DBIC_SIGNIFICANT:g} on the "
+            f"fitting runs; it is {dbic:.1f})"
+        )
+    if r1 <= R_WITHIN or removed >= EXCESS_REMOVED:
+        return label, (
+            f"{label} brings the held-out misfit from {r0:.2f} to {r1:.2f} x the background "
+            f"(named at <= {R_WITHIN:g} x, or when it removes >= {EXCESS_REMOVED:.0%} of the "
+            f"misfit above the background: {removed:.0%})"
+        )
+    return "unexplained", (
+        f"the best candidate, {label}, leaves {r1:.2f} x the background on the held-out runs "
+        f"(from {r0:.2f}; it removes {removed:.0%} of the misfit above the background): no "
+        "hypothesis closes the gap"
+    )
+
+
+THRESHOLDS = {
+    "heldout_ratio_gap": R_GAP,
+    "heldout_ratio_gap_with_bic": R_GAP_WITH_BIC,
+    "heldout_ratio_named": R_WITHIN,
+    "heldout_excess_removed_named": EXCESS_REMOVED,
+}
