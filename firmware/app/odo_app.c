@@ -101,11 +101,12 @@ static uint32_t check_seq(odo_app_t *app, uint8_t truck, uint8_t seq, uint64_t t
             }
             n = step < 128U ? step : 256U - step; /* older than the last sample: its distance back */
         }
-        /* The sequence number wraps at 256: from 128 ticks on, the clock counts them. */
+        /* The sequence number wraps at 256: from 128 ticks on, the clock counts them
+         * (tick_us <= 1 s keeps 128 ticks below 2^32 us). */
         const uint64_t last = app->last_wheel_t_us[truck];
         const uint32_t tick_us = app->params.tick_us;
-        if (t_us >= last && t_us - last >= ((uint64_t)tick_us << 7)) {
-            const uint64_t dt = t_us - last;
+        const uint64_t dt = t_us - last;
+        if (t_us >= last && ((dt >> 32) != 0U || (uint32_t)dt >= (tick_us << 7))) {
             n = dt > UINT32_MAX ? UINT32_MAX : ticks_in((uint32_t)dt, tick_us);
         }
     }
@@ -123,49 +124,60 @@ static const uint32_t FAULT_DECODER[ODO_TRUCKS] = {ODO_FAULT_DECODER_A, ODO_FAUL
 /// Bit indices of the two faults STATUS.Rejected counts (checked against odo_status.h below).
 #define FAULT_BIT_CAN_BAD_DLC    14U
 #define FAULT_BIT_CAN_UNKNOWN_ID 15U
-typedef char fault_bit_bad_dlc_matches[(1UL << FAULT_BIT_CAN_BAD_DLC) == ODO_FAULT_CAN_BAD_DLC ? 1 : -1];
-typedef char fault_bit_unknown_id_matches[(1UL << FAULT_BIT_CAN_UNKNOWN_ID) == ODO_FAULT_CAN_UNKNOWN_ID ? 1 : -1];
+typedef char fault_bit_bad_dlc_matches[(ODO_FAULT_CAN_BAD_DLC >> FAULT_BIT_CAN_BAD_DLC) == 1U ? 1 : -1];
+typedef char fault_bit_unknown_id_matches[(ODO_FAULT_CAN_UNKNOWN_ID >> FAULT_BIT_CAN_UNKNOWN_ID) == 1U ? 1 : -1];
 
-/// Pack this tick's frames. A position beyond POSE_XY's range is sent saturated and flagged here,
-/// in out->faults and that truck's POSE_THETA flags, before STATUS is packed.
-static void publish(const odo_app_t *app, uint8_t pose_flags[ODO_TRUCKS], odo_tick_output_t *out)
+/// One POSE_XY coordinate: mm Q32 to 10 um, saturated to int32 (the frame's +-21.47 km).
+static inline int32_t xy_10um(int64_t v_mm_q32, bool *sat)
 {
-    uint8_t n = 0U;
-    for (uint8_t i = 0U; i < app->trucks; ++i) {
-        bool sat = false;
-        const odo_msg_pose_xy_t xy = {odo_mm_q32_to_10um(out->pose[i].x_mm_q32, &sat),
-                                      odo_mm_q32_to_10um(out->pose[i].y_mm_q32, &sat)};
-        if (sat) {
-            out->faults |= ODO_FAULT_POSE_XY_SATURATED;
-            pose_flags[i] |= ODO_POSE_FLAG_XY_SATURATED;
-        }
-        const odo_msg_pose_theta_t th = {odo_heading_bam(&out->pose[i]), app->out_seq, pose_flags[i]};
-        odo_can_pack_pose_xy(i, &xy, &out->frames[n++]);
-        odo_can_pack_pose_theta(i, &th, &out->frames[n++]);
+    const int64_t v = odo_mm_q32_to_10um_wide(v_mm_q32);
+    if (v > INT32_MAX || v < INT32_MIN) {
+        *sat = true;
+        return v > 0 ? INT32_MAX : INT32_MIN;
     }
-    if (app->trucks == 2U) {
-        const odo_msg_ipec_corr_t corr = {out->ipec_dtheta_bam[0], out->ipec_dtheta_bam[1]};
-        odo_can_pack_ipec_corr(&corr, &out->frames[n++]);
+    return (int32_t)v;
+}
+
+/// A truck's POSE_XY and POSE_THETA frames into f[0..1]. A position beyond POSE_XY's range is
+/// sent saturated and flagged (the truck's flags and, through *faults, STATUS).
+static void publish_truck(const odo_pose_t *pose, uint8_t truck, uint8_t seq, uint8_t flags, uint32_t *faults,
+                          odo_can_frame_t *f)
+{
+    bool sat = false;
+    const odo_msg_pose_xy_t xy = {xy_10um(pose->x_mm_q32, &sat), xy_10um(pose->y_mm_q32, &sat)};
+    if (sat) {
+        *faults |= ODO_FAULT_POSE_XY_SATURATED;
+        flags |= ODO_POSE_FLAG_XY_SATURATED;
     }
-    /* Rejected frames since boot, this tick's included (counted after publishing). */
-    const uint64_t rejected =
-        (uint64_t)app->faults.count[FAULT_BIT_CAN_BAD_DLC] + app->faults.count[FAULT_BIT_CAN_UNKNOWN_ID] +
-        ((out->faults >> FAULT_BIT_CAN_BAD_DLC) & 1U) + ((out->faults >> FAULT_BIT_CAN_UNKNOWN_ID) & 1U);
-    const odo_msg_status_t st = {out->faults, app->out_seq, (uint8_t)app->params_status,
+    const odo_msg_pose_theta_t th = {(uint32_t)((pose->heading_q64 + 0x80000000ULL) >> 32), seq, flags};
+    odo_can_pack_pose_xy(truck, &xy, &f[0]);
+    odo_can_pack_pose_theta(truck, &th, &f[1]);
+}
+
+/// STATUS: this tick's faults, the sequence number, the boot-time parameter state and the
+/// rejected frames since boot, this tick's included (the counters are updated after publishing).
+static void publish_status(const odo_app_t *app, uint32_t faults, odo_can_frame_t *f)
+{
+    const uint32_t c_dlc = app->faults.count[FAULT_BIT_CAN_BAD_DLC];
+    const uint32_t c_id = app->faults.count[FAULT_BIT_CAN_UNKNOWN_ID];
+    const uint32_t now = ((faults >> FAULT_BIT_CAN_BAD_DLC) & 1U) + ((faults >> FAULT_BIT_CAN_UNKNOWN_ID) & 1U);
+    /* saturating at 65535 without a 64-bit sum: each count saturates at 2^32 - 1 */
+    const uint32_t rejected = (c_dlc > UINT16_MAX || c_id > UINT16_MAX) ? UINT16_MAX : c_dlc + c_id + now;
+    const odo_msg_status_t st = {faults, app->out_seq, (uint8_t)app->params_status,
                                  (uint16_t)(rejected > UINT16_MAX ? UINT16_MAX : rejected)};
-    odo_can_pack_status(&st, &out->frames[n++]);
-    out->n_frames = n;
+    odo_can_pack_status(&st, f);
 }
 
 /// Linkage check and, with IPEC on, the correction of both trucks (odo_ipec.h). Returns faults.
+/// With IPEC off only the check runs (its faults are reported); the reading is not decoded.
 static uint32_t ipec_tick(odo_app_t *app, const odo_tick_input_t *in, bool dr_ok, uint8_t pose_flags[ODO_TRUCKS],
                           odo_tick_output_t *out)
 {
-    odo_ipec_reading_t rd;
-    uint32_t f = odo_ipec_check(&app->ipec, &app->params, &in->link, &rd);
     if (app->params.ipec_mode == (uint8_t)ODO_IPEC_OFF) {
-        return f;
+        return odo_ipec_check(&app->ipec, &app->params, &in->link, NULL);
     }
+    odo_ipec_reading_t rd;
+    const uint32_t f = odo_ipec_check(&app->ipec, &app->params, &in->link, &rd);
     if (f != 0U || !dr_ok) {
         pose_flags[ODO_TRUCK_A] |= ODO_POSE_FLAG_IPEC_GATED;
         pose_flags[ODO_TRUCK_B] |= ODO_POSE_FLAG_IPEC_GATED;
@@ -186,35 +198,49 @@ static uint32_t ipec_tick(odo_app_t *app, const odo_tick_input_t *in, bool dr_ok
     return f;
 }
 
-/// One truck's wheel sample: sequence and decoder checks, then odometry over the ticks elapsed.
-/// Returns odo_step_t.range (the pose is beyond ODO_POSE_LIMIT_MM_Q32).
-static bool wheel_step(odo_app_t *app, uint8_t i, const odo_wheel_input_t *w, uint64_t t_us, uint32_t *faults,
-                       uint8_t *pose_flags, bool *dr_ok, odo_tick_output_t *out)
+/// Flags that mean a truck's dead reckoning did not run this tick (IPEC must not compare).
+#define POSE_FLAGS_NOT_INTEGRATED (ODO_POSE_FLAG_MISSING | ODO_POSE_FLAG_JUMP | ODO_POSE_FLAG_RANGE)
+
+/// One truck's wheel sample: presence, decoder and sequence checks, then odometry over the ticks
+/// elapsed (odo_truck_tick). Writes this tick's dist_mm_q40/dturn_q64 of the truck, ORs its
+/// faults into *faults and returns its pose flags.
+static uint8_t truck_tick(odo_app_t *app, uint8_t i, const odo_wheel_input_t *w, uint64_t t_us, uint32_t *faults,
+                          odo_tick_output_t *out)
 {
-    if ((w->status & (ODO_WHEEL_STATUS_LEFT_SKIPPED | ODO_WHEEL_STATUS_RIGHT_SKIPPED | ODO_WHEEL_STATUS_LEFT_FAULT |
-                      ODO_WHEEL_STATUS_RIGHT_FAULT)) != 0U) {
-        *faults |= FAULT_DECODER[i];
+    uint32_t f = 0U;
+    uint8_t flags = 0U;
+    uint32_t r;
+    int64_t motion[2] = {0, 0};
+    if (!w->present) {
+        f = FAULT_MISSING[i];
+        flags = ODO_POSE_FLAG_MISSING;
+        r = odo_pose_in_range(&app->truck[i].pose) ? 0U : ODO_STEP_RANGE;
+    } else {
+        if ((w->status & (ODO_WHEEL_STATUS_LEFT_SKIPPED | ODO_WHEEL_STATUS_RIGHT_SKIPPED | ODO_WHEEL_STATUS_LEFT_FAULT |
+                          ODO_WHEEL_STATUS_RIGHT_FAULT)) != 0U) {
+            f = FAULT_DECODER[i];
+        }
+        uint32_t ticks = 1U;
+        f |= check_seq(app, i, w->seq, t_us, &ticks);
+        r = odo_truck_tick(&app->truck[i], &app->model[i], w, ticks, motion);
     }
-    uint32_t ticks = 1U;
-    *faults |= check_seq(app, i, w->seq, t_us, &ticks);
-    odo_step_t st;
-    odo_truck_step(&app->truck[i], &app->model[i], w->left_raw, w->right_raw, w->bits, ticks, &st);
-    if (st.jump) {
-        *dr_ok = false;
-        *faults |= FAULT_JUMP[i];
-        *pose_flags |= ODO_POSE_FLAG_JUMP;
+    out->dist_mm_q40[i] = motion[0];
+    out->dturn_q64[i] = motion[1];
+    if ((r & ODO_STEP_JUMP) != 0U) {
+        f |= FAULT_JUMP[i];
+        flags |= ODO_POSE_FLAG_JUMP;
     }
-    out->dist_mm_q40[i] = st.dist_mm_q40;
-    out->dturn_q64[i] = st.dturn_q64;
-    return st.range;
+    if ((r & ODO_STEP_RANGE) != 0U) {
+        f |= ODO_FAULT_POSE_RANGE; /* held from the next step on; IPEC must not move it either */
+        flags |= ODO_POSE_FLAG_RANGE;
+    }
+    *faults |= f;
+    return flags;
 }
 
 void odo_app_step(odo_app_t *app, const odo_tick_input_t *in, odo_tick_output_t *out)
 {
     uint32_t faults = in->rx_faults;
-    uint8_t pose_flags[ODO_TRUCKS] = {0U, 0U};
-    memset(out, 0, sizeof *out);
-
     if (app->params_status != ODO_PARAMS_OK) {
         faults |= ODO_FAULT_PARAMS_DEFAULTED;
     }
@@ -224,35 +250,41 @@ void odo_app_step(odo_app_t *app, const odo_tick_input_t *in, odo_tick_output_t 
     app->have_time = true;
     app->last_t_us = in->t_us;
 
-    bool dr_ok = true; /* every truck's sample integrated: IPEC may compare */
-    for (uint8_t i = 0U; i < app->trucks; ++i) {
-        const odo_wheel_input_t *w = &in->wheel[i];
-        bool range;
-        if (!w->present) {
-            dr_ok = false;
-            faults |= FAULT_MISSING[i];
-            pose_flags[i] |= ODO_POSE_FLAG_MISSING;
-            range = !odo_pose_in_range(&app->truck[i].pose);
-        } else {
-            range = wheel_step(app, i, w, in->t_us, &faults, &pose_flags[i], &dr_ok, out);
-        }
-        if (range) {
-            dr_ok = false; /* held from the next step on; IPEC must not move it either */
-            faults |= ODO_FAULT_POSE_RANGE;
-            pose_flags[i] |= ODO_POSE_FLAG_RANGE;
-        }
-    }
-
+    /* Every output field is written below; no memset of the whole struct (frames beyond
+     * n_frames are left as they were). */
+    out->ipec_applied = false;
+    out->ipec_dtheta_bam[ODO_TRUCK_A] = 0;
+    out->ipec_dtheta_bam[ODO_TRUCK_B] = 0;
+    out->ipec_innov_bam[ODO_TRUCK_A] = 0;
+    out->ipec_innov_bam[ODO_TRUCK_B] = 0;
+    uint8_t flags[ODO_TRUCKS] = {0U, 0U};
+    flags[ODO_TRUCK_A] = truck_tick(app, ODO_TRUCK_A, &in->wheel[ODO_TRUCK_A], in->t_us, &faults, out);
     if (app->trucks == 2U) {
-        faults |= ipec_tick(app, in, dr_ok, pose_flags, out);
+        flags[ODO_TRUCK_B] = truck_tick(app, ODO_TRUCK_B, &in->wheel[ODO_TRUCK_B], in->t_us, &faults, out);
+        const bool dr_ok = ((flags[ODO_TRUCK_A] | flags[ODO_TRUCK_B]) & POSE_FLAGS_NOT_INTEGRATED) == 0U;
+        faults |= ipec_tick(app, in, dr_ok, flags, out);
+    } else {
+        out->dist_mm_q40[ODO_TRUCK_B] = 0;
+        out->dturn_q64[ODO_TRUCK_B] = 0;
     }
 
-    for (uint8_t i = 0U; i < ODO_TRUCKS; ++i) {
-        out->pose[i] = app->truck[i].pose;
+    out->pose[ODO_TRUCK_A] = app->truck[ODO_TRUCK_A].pose;
+    out->pose[ODO_TRUCK_B] = app->truck[ODO_TRUCK_B].pose;
+    odo_can_frame_t *f = out->frames;
+    publish_truck(&out->pose[ODO_TRUCK_A], ODO_TRUCK_A, app->out_seq, flags[ODO_TRUCK_A], &faults, f);
+    f += 2;
+    if (app->trucks == 2U) {
+        publish_truck(&out->pose[ODO_TRUCK_B], ODO_TRUCK_B, app->out_seq, flags[ODO_TRUCK_B], &faults, f);
+        const odo_msg_ipec_corr_t corr = {out->ipec_dtheta_bam[ODO_TRUCK_A], out->ipec_dtheta_bam[ODO_TRUCK_B]};
+        odo_can_pack_ipec_corr(&corr, &f[2]);
+        f += 3;
     }
+    publish_status(app, faults, f++);
+    out->n_frames = (uint8_t)(f - out->frames);
     out->faults = faults;
-    publish(app, pose_flags, out);
-    count_faults(&app->faults, out->faults);
+    if (faults != 0U) {
+        count_faults(&app->faults, faults);
+    }
     app->out_seq++;
     app->ticks++;
 }

@@ -69,7 +69,13 @@ odo_model_status_t odo_model_init(odo_model_t *m, const odo_truck_params_t *tp, 
 
     /* Largest believable count change per tick: the faster wheel at max speed, plus one count.
      * counts = (v * tick) / k = d_um * 2^40 / (1000 * k_q40), using the smaller k. */
-    const uint64_t d_um = ((uint64_t)max_wheel_speed_mm_s * tick_us + 999U) / 1000U;
+    /* ceil(v * tick / 1000) in um, v * 1000 a + v b with tick = 1000 a + b: 32-bit divisions
+     * only (v <= 20000 mm/s keeps v b + 999 below 2^32). */
+    if (max_wheel_speed_mm_s > 4000000U) {
+        return ODO_MODEL_ERR_RANGE;
+    }
+    const uint64_t d_um =
+        (uint64_t)max_wheel_speed_mm_s * (tick_us / 1000U) + (max_wheel_speed_mm_s * (tick_us % 1000U) + 999U) / 1000U;
     const uint64_t k_min = (uint64_t)(mm.dist_mm_q40[0] < mm.dist_mm_q40[1] ? mm.dist_mm_q40[0] : mm.dist_mm_q40[1]);
     uint64_t max_counts;
     if (!odo_muldiv_u64(d_um, (uint64_t)1U << 40, 1000U * k_min, &max_counts)) {
@@ -99,7 +105,14 @@ odo_model_status_t odo_model_init(odo_model_t *m, const odo_truck_params_t *tp, 
      * wheels, so their sum cannot overflow. At least max_counts, by the check above. */
     uint64_t max_delta = (uint64_t)INT32_MAX;
     for (unsigned w = 0U; w < 2U; ++w) {
-        const uint64_t q = (DIST_LIMIT_Q40 - 1U) / (uint64_t)mm.dist_mm_q40[w];
+        /* floor((2^61 - 1) / k) through the shared 128-bit division (no 64-bit division in the
+         * image): round, then step back if the rounding went up. */
+        const uint64_t k = (uint64_t)mm.dist_mm_q40[w];
+        uint64_t q;
+        if (!odo_muldiv_u64(DIST_LIMIT_Q40 - 1U, 1U, k, &q)) {
+            return ODO_MODEL_ERR_RANGE;
+        }
+        q -= (q * k > DIST_LIMIT_Q40 - 1U) ? 1U : 0U;
         max_delta = q < max_delta ? q : max_delta;
     }
     mm.max_counts = (uint32_t)max_counts;
@@ -111,18 +124,126 @@ odo_model_status_t odo_model_init(odo_model_t *m, const odo_truck_params_t *tp, 
     return ODO_MODEL_OK;
 }
 
+/// The modular delta of a w-bit counter, w in [1, 32]: the low w bits of cur - prev read as a
+/// w-bit two's complement number (xor-subtract sign extension). Branch-free.
+static inline int32_t delta_bits(uint32_t prev, uint32_t cur, unsigned w)
+{
+    const uint32_t mask = UINT32_MAX >> (32U - w);
+    const uint32_t sign = (uint32_t)0x80000000U >> (32U - w);
+    return odo_as_s32((((cur - prev) & mask) ^ sign) - sign);
+}
+
+/// |v| as unsigned; exact for INT32_MIN.
+static inline uint32_t mag32(int32_t v) { return v < 0 ? 0U - (uint32_t)v : (uint32_t)v; }
+
+/// v in [-L, L) iff v + L (modulo 2^64) is below 2L = 2^62: one OR tests both coordinates.
+static inline bool in_range(const odo_pose_t *p)
+{
+    const uint64_t lim = (uint64_t)ODO_POSE_LIMIT_MM_Q32;
+    return ((((uint64_t)p->x_mm_q32 + lim) | ((uint64_t)p->y_mm_q32 + lim)) >> 62) == 0U;
+}
+
+/// The direction of 000 Eq. 2.5's step as a BAM: the new heading (Eq. 2.6, PAPER) or the
+/// midpoint, the old heading plus floor(dturn / 2), which is exact in direction for a
+/// constant-curvature arc (second-order accurate).
+static inline uint32_t step_direction_bam(const odo_pose_t *p, int64_t dturn_q64, uint8_t heading_form)
+{
+    const int64_t part = (heading_form == (uint8_t)ODO_HEADING_PAPER) ? dturn_q64 : odo_floor_shr_s64(dturn_q64, 1U);
+    return (uint32_t)((p->heading_q64 + (uint64_t)part + 0x80000000ULL) >> 32);
+}
+
+/// 000 Eqs. 2.5, 2.6 given the direction's sin and cos: two inline 64x32 products (Q40 mm x Q30 ->
+/// Q32 mm; |dist| < 2^62 keeps each below 2^54), then the heading turns by dturn.
+static inline void move(odo_pose_t *p, int64_t dist_mm_q40, int64_t dturn_q64, int32_t s, int32_t c)
+{
+    p->x_mm_q32 += odo_mul_s64_s32_rnd(dist_mm_q40, c, 38U);
+    p->y_mm_q32 += odo_mul_s64_s32_rnd(dist_mm_q40, s, 38U);
+    p->heading_q64 += (uint64_t)dturn_q64;
+}
+
+/// The one body of odo_truck_step and odo_truck_tick (see odo_truck_step for the contract). A step
+/// of one tick stays in 32-bit arithmetic up to the products of 000 Eqs. 2.2-2.4: two 64x32 each
+/// for distance and heading. Writes *dist, *dturn and d[] (0 when nothing was integrated) and
+/// returns ODO_STEP_* bits.
+static inline uint32_t step(odo_truck_t *t, const odo_model_t *m, uint32_t left_raw, uint32_t right_raw, uint8_t bits,
+                            uint32_t ticks, int64_t *dist_out, int64_t *dturn_out, int32_t d_out[2])
+{
+    const uint8_t w_bits = bits < m->counter_bits ? bits : m->counter_bits;
+    *dist_out = 0;
+    *dturn_out = 0;
+    d_out[0] = 0;
+    d_out[1] = 0;
+    const uint32_t prev_l = t->last_raw[0], prev_r = t->last_raw[1];
+    t->last_raw[0] = left_raw;
+    t->last_raw[1] = right_raw;
+    if (!t->primed) {
+        t->primed = true;
+        return 0U;
+    }
+    if (w_bits == 0U) {
+        return ODO_STEP_JUMP; /* a reading of no bits tells nothing */
+    }
+    /* The wheel may travel max_counts per tick elapsed. A modular delta of a w-bit reading is
+     * unambiguous only below 2^(w-1): if the wheel could have gone that far since the previous
+     * reading, the reading cannot be trusted whatever it says. One tick stays in 32 bits. */
+    const uint32_t half_range = (uint32_t)1U << (w_bits - 1U);
+    uint32_t limit = m->max_counts;
+    bool jump;
+    if (ticks <= 1U) {
+        jump = limit >= half_range;
+    } else {
+        const uint64_t reach = (uint64_t)limit * ticks; /* 32x32 -> 64: cannot overflow */
+        jump = reach >= half_range;
+        limit = reach < m->max_delta_counts ? (uint32_t)reach : m->max_delta_counts;
+    }
+    int32_t d_l = delta_bits(prev_l, left_raw, w_bits);
+    int32_t d_r = delta_bits(prev_r, right_raw, w_bits);
+    if (jump || mag32(d_l) > limit || mag32(d_r) > limit) {
+        return ODO_STEP_JUMP; /* physically impossible or ambiguous: do not integrate garbage */
+    }
+    if (!in_range(&t->pose)) {
+        return ODO_STEP_RANGE; /* one more step could leave int64: hold the pose */
+    }
+    /* |d| <= limit < 2^31 here, so negation is safe. */
+    if ((m->invert & ODO_TRUCK_INVERT_LEFT) != 0U) {
+        d_l = -d_l;
+    }
+    if ((m->invert & ODO_TRUCK_INVERT_RIGHT) != 0U) {
+        d_r = -d_r;
+    }
+    /* Eqs. 2.2/6.35 and 2.3: |d| <= max_delta_counts, so |k d| < 2^61 and the sum fits; its
+     * half is rounded half up. */
+    const int64_t dist = odo_floor_shr_s64(m->dist_mm_q40[0] * d_l + m->dist_mm_q40[1] * d_r + 1, 1U);
+    /* Eq. 2.4 in turns: modular arithmetic on uint64 is exact whatever the size of d; read as a
+     * signed change it is below a quarter turn per tick elapsed (checked at init). */
+    int64_t dturn = odo_as_s64(m->turn_q64[1] * (uint64_t)(int64_t)d_r - m->turn_q64[0] * (uint64_t)(int64_t)d_l);
+    if (m->scrub_q30 != 0) {
+        /* g = 1 - k m / v, |k m / v| <= 1/4; modulo a turn, as a gap's dturn may be near half a
+         * turn already. */
+        dturn = odo_as_s64((uint64_t)dturn - (uint64_t)odo_scrub_dturn(m, d_l, d_r));
+    }
+    /* Over several ticks the midpoint form's step (the arc length U along the chord's direction)
+     * overshoots by U (1 - sinc(dtheta/2)), an error that grows with the cube of the gap: take the
+     * chord of the constant-curvature arc instead (only on this rare path; per tick the paper's
+     * U stays, as the double reference has it). */
+    const int64_t along = (ticks > 1U && m->heading_form == (uint8_t)ODO_HEADING_MIDPOINT)
+                              ? odo_mul_s64_s32_shr(dist, odo_sinc_half_q30(dturn), 30U)
+                              : dist;
+    const uint64_t sc = odo_sincos_pair_q30(step_direction_bam(&t->pose, dturn, m->heading_form));
+    move(&t->pose, along, dturn, odo_sincos_sin_q30(sc), odo_sincos_cos_q30(sc));
+    *dist_out = dist;
+    *dturn_out = dturn;
+    d_out[0] = d_l;
+    d_out[1] = d_r;
+    return in_range(&t->pose) ? 0U : ODO_STEP_RANGE; /* held from the next step on */
+}
+
 int32_t odo_count_delta(uint32_t prev, uint32_t cur, uint8_t bits)
 {
-    if ((unsigned)bits - 1U >= 31U) { /* 0, or 32 and above */
-        if (bits == 0U) {
-            return 0; /* no bits, no information */
-        }
-        const uint32_t d = cur - prev;
-        return d >= 0x80000000UL ? (int32_t)((int64_t)d - ((int64_t)1 << 32)) : (int32_t)d;
+    if (bits == 0U) {
+        return 0; /* no bits, no information */
     }
-    const uint32_t mask = ((uint32_t)1U << bits) - 1U;
-    const uint32_t d = (cur - prev) & mask;
-    return d >= ((uint32_t)1U << (bits - 1U)) ? (int32_t)((int64_t)d - ((int64_t)1 << bits)) : (int32_t)d;
+    return delta_bits(prev, cur, bits > 32U ? 32U : bits);
 }
 
 void odo_truck_reset(odo_truck_t *t, const odo_pose_t *pose)
@@ -133,25 +254,9 @@ void odo_truck_reset(odo_truck_t *t, const odo_pose_t *pose)
     t->primed = false;
 }
 
-/// Reinterpret a uint64 as two's complement int64 without implementation-defined conversion.
-static int64_t as_signed(uint64_t u) { return u <= (uint64_t)INT64_MAX ? (int64_t)u : -(int64_t)(~u) - 1; }
-
-/// |v| as unsigned; exact for INT32_MIN.
-static uint32_t mag32(int32_t v) { return v < 0 ? 0U - (uint32_t)v : (uint32_t)v; }
-
-/// v in [-L, L) iff v + L (modulo 2^64) is below 2L = 2^62: one OR tests both coordinates.
-static bool in_range(const odo_pose_t *p)
-{
-    const uint64_t lim = (uint64_t)ODO_POSE_LIMIT_MM_Q32;
-    return ((((uint64_t)p->x_mm_q32 + lim) | ((uint64_t)p->y_mm_q32 + lim)) >> 62) == 0U;
-}
-
 bool odo_pose_in_range(const odo_pose_t *p) { return in_range(p); }
 
-/// sin(x) / x in Q30 for x = dtheta / 2, dtheta = dturn_q64 signed turns (below half a turn):
-/// 1 - x^2/6 + x^4/120 - x^6/5040 in Horner form, within 3e-5 up to |x| = pi/2. Multiplies only
-/// (Q30 reciprocals of 42, 20 and 6), every product below 2^62.
-static int32_t sinc_half_q30(int64_t dturn_q64)
+int32_t odo_sinc_half_q30(int64_t dturn_q64)
 {
     /* x in rad Q30 = pi * dturn / 2^64 * 2^30 = dturn * (pi * 2^29) / 2^63; |x| < pi/2 */
     const int64_t x = odo_mul_s64_s32_shr(dturn_q64, 1686629713, 63U);
@@ -173,113 +278,40 @@ int64_t odo_scrub_dturn(const odo_model_t *m, int32_t d_left, int32_t d_right)
     const uint32_t mv = 2U * (a < b ? a : b); /* <= v */
     /* k * dtheta from the k-scaled multipliers, with the same exact modular sum as Eq. 2.4. */
     const int64_t k_dturn =
-        as_signed(m->scrub_turn_q64[1] * (uint64_t)(int64_t)d[1] - m->scrub_turn_q64[0] * (uint64_t)(int64_t)d[0]);
+        odo_as_s64(m->scrub_turn_q64[1] * (uint64_t)(int64_t)d[1] - m->scrub_turn_q64[0] * (uint64_t)(int64_t)d[0]);
     if (mv == v) {
         return k_dturn; /* equal wheels: m / v = 1 (does not fit Q32) */
     }
     return odo_mul_s64_u32_shr(k_dturn, odo_frac_q32(mv, v), 32U);
 }
 
+uint32_t odo_truck_tick(odo_truck_t *t, const odo_model_t *m, const odo_wheel_input_t *w, uint32_t ticks,
+                        int64_t motion[2])
+{
+    int32_t d[2];
+    return step(t, m, w->left_raw, w->right_raw, w->bits, ticks, &motion[0], &motion[1], d);
+}
+
 void odo_truck_step(odo_truck_t *t, const odo_model_t *m, uint32_t left_raw, uint32_t right_raw, uint8_t bits,
                     uint32_t ticks, odo_step_t *out)
 {
-    const uint32_t raw[2] = {left_raw, right_raw};
-    const uint8_t w_bits = bits < m->counter_bits ? bits : m->counter_bits;
-    out->dist_mm_q40 = 0;
-    out->dturn_q64 = 0;
-    out->delta[0] = 0;
-    out->delta[1] = 0;
-    out->jump = false;
-    out->range = false;
-    if (!t->primed) {
-        t->last_raw[0] = raw[0];
-        t->last_raw[1] = raw[1];
-        t->primed = true;
-        return;
-    }
-
-    /* The wheel may travel max_counts per tick elapsed. A modular delta of a w-bit reading is
-     * unambiguous only below 2^(w-1): if the wheel could have gone that far since the previous
-     * reading, the reading cannot be trusted whatever it says (32x32 -> 64: cannot overflow). */
-    uint64_t reach = m->max_counts; /* counts the wheel could have turned since the last reading */
-    if (ticks > 1U) {
-        reach *= ticks;
-    }
-    out->jump = w_bits == 0U || reach >= ((uint64_t)1U << (w_bits - 1U));
-    const uint32_t limit = reach < m->max_delta_counts ? (uint32_t)reach : m->max_delta_counts;
-    int32_t d[2];
-    for (unsigned w = 0U; w < 2U; ++w) {
-        d[w] = odo_count_delta(t->last_raw[w], raw[w], w_bits);
-        if (mag32(d[w]) > limit) {
-            out->jump = true; /* physically impossible: do not integrate garbage */
-        }
-    }
-    t->last_raw[0] = raw[0];
-    t->last_raw[1] = raw[1];
-    if (out->jump) {
-        return;
-    }
-    if (!in_range(&t->pose)) {
-        out->range = true; /* one more step could leave int64: hold the pose */
-        return;
-    }
-    /* |d| <= limit < 2^31 here, so negation is safe. */
-    if ((m->invert & ODO_TRUCK_INVERT_LEFT) != 0U) {
-        d[0] = -d[0];
-    }
-    if ((m->invert & ODO_TRUCK_INVERT_RIGHT) != 0U) {
-        d[1] = -d[1];
-    }
-
-    /* Eqs. 2.2/6.35 and 2.3: |d| <= max_delta_counts, so |k * d| < 2^61 and the sum fits. */
-    const int64_t s_l = m->dist_mm_q40[0] * d[0];
-    const int64_t s_r = m->dist_mm_q40[1] * d[1];
-    const int64_t dist = odo_shr_round_s64(s_l + s_r, 1U);
-    /* Eq. 2.4 in turns: modular arithmetic on uint64 is exact whatever the size of d; read as a
-     * signed change it is below a quarter turn per tick elapsed (checked at init). */
-    const uint64_t dturn_u = m->turn_q64[1] * (uint64_t)(int64_t)d[1] - m->turn_q64[0] * (uint64_t)(int64_t)d[0];
-    int64_t dturn = as_signed(dturn_u);
-    if (m->scrub_q30 != 0) {
-        /* g = 1 - k m / v, |k m / v| <= 1/4; modulo a turn, as a gap's dturn may be near half a
-         * turn already. */
-        dturn = as_signed((uint64_t)dturn - (uint64_t)odo_scrub_dturn(m, d[0], d[1]));
-    }
-
-    /* Over several ticks the midpoint form's step (the arc length U along the chord's direction)
-     * overshoots by U (1 - sinc(dtheta/2)), an error that grows with the cube of the gap: take the
-     * chord of the constant-curvature arc instead (only on this rare path; per tick the paper's
-     * U stays, as the double reference has it). */
-    const int64_t step = (ticks > 1U && m->heading_form == (uint8_t)ODO_HEADING_MIDPOINT)
-                             ? odo_mul_s64_s32_shr(dist, sinc_half_q30(dturn), 30U)
-                             : dist;
-    odo_pose_advance(&t->pose, step, dturn, m->heading_form);
-    out->range = !in_range(&t->pose); /* held from the next step on */
-    out->dist_mm_q40 = dist;
-    out->dturn_q64 = dturn;
-    out->delta[0] = d[0];
-    out->delta[1] = d[1];
+    const uint32_t r = step(t, m, left_raw, right_raw, bits, ticks, &out->dist_mm_q40, &out->dturn_q64, out->delta);
+    out->jump = (r & ODO_STEP_JUMP) != 0U;
+    out->range = (r & ODO_STEP_RANGE) != 0U;
 }
 
 void odo_pose_advance(odo_pose_t *p, int64_t dist_mm_q40, int64_t dturn_q64, uint8_t heading_form)
 {
-    const uint64_t h_new = p->heading_q64 + (uint64_t)dturn_q64;
-    /* Eq. 2.6 advances along the new heading; the midpoint form along theta_{i-1} + dtheta/2,
-     * which is exact in direction for a constant-curvature arc (second-order accurate). */
-    const uint64_t h_dir =
-        (heading_form == (uint8_t)ODO_HEADING_PAPER) ? h_new : p->heading_q64 + (uint64_t)(dturn_q64 / 2);
     int32_t s, c;
-    odo_sincos_q30((uint32_t)((h_dir + 0x80000000ULL) >> 32), &s, &c);
-    /* Q40 mm * Q30 -> Q32 mm: shift by 38. */
-    p->x_mm_q32 += odo_mul_s64_s32_shr(dist_mm_q40, c, 38U);
-    p->y_mm_q32 += odo_mul_s64_s32_shr(dist_mm_q40, s, 38U);
-    p->heading_q64 = h_new;
+    odo_sincos_q30(step_direction_bam(p, dturn_q64, heading_form), &s, &c);
+    move(p, dist_mm_q40, dturn_q64, s, c);
 }
 
 uint32_t odo_heading_bam(const odo_pose_t *p) { return (uint32_t)((p->heading_q64 + 0x80000000ULL) >> 32); }
 
 int32_t odo_mm_q32_to_10um(int64_t v_mm_q32, bool *saturated)
 {
-    const int64_t v = odo_mul_s64_s32_shr(v_mm_q32, 100, 32U);
+    const int64_t v = odo_mm_q32_to_10um_wide(v_mm_q32);
     if (v > INT32_MAX || v < INT32_MIN) {
         if (saturated != NULL) {
             *saturated = true;

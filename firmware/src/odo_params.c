@@ -356,8 +356,6 @@ size_t odo_params_reserved_offset(const uint8_t *buf, size_t len)
 
 odo_params_status_t odo_params_parse(const uint8_t *buf, size_t len, odo_params_t *out)
 {
-    odo_params_t p;
-
     if ((buf == NULL) || (out == NULL)) {
         return ODO_PARAMS_ERR_ARG;
     }
@@ -384,18 +382,19 @@ odo_params_status_t odo_params_parse(const uint8_t *buf, size_t len, odo_params_
         return ODO_PARAMS_ERR_CRC;
     }
 
-    memset(&p, 0, sizeof p); /* fields a version-1 block does not carry read as 0 */
+    /* Every check that leaves *out untouched is above: from here on the fields go straight into
+     * *out (no local copy: the boot path's stack is part of the RAM budget). */
+    memset(out, 0, sizeof *out); /* fields a version-1 block does not carry read as 0 */
     for (size_t i = 0U; i < N_FIELDS; i++) {
         const odo_param_field_info_t *f = &k_fields[i];
         if (f->since > version) {
             continue;
         }
         for (unsigned t = 0U; t < instances(f); t++) {
-            store_bits(&p, f, t, get_le(&buf[f->offset + t * f->stride], f->width));
+            store_bits(out, f, t, get_le(&buf[f->offset + t * f->stride], f->width));
         }
     }
 
-    *out = p;
     /* Non-zero reserved bytes mean a writer that knows a layout we do not: refuse, never guess. */
     return (first_reserved(buf, version, crc_off) == 0U) ? ODO_PARAMS_OK : ODO_PARAMS_ERR_RANGE;
 }

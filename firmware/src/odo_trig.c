@@ -1,189 +1,140 @@
 /// Sine, cosine and two-argument arctangent on binary angles (odo_fx.h), integer only.
 ///
 /// Method
-///   sin/cos  The top three BAM bits pick an octant; the 29-bit remainder (mirrored in odd
-///            octants) becomes x in [0, pi/4] in Q31. sin x and cos x are the Taylor series
-///            (Abramowitz & Stegun 4.3.65, 4.3.66) to x^11 and x^12 in Horner form with exact
-///            integer denominators; the octant then picks which of the two answers and its sign.
-///   atan2    The magnitudes fold the vector into the first octant, 0 <= n <= d. One division
-///            gives t = n/d, or u = (d-n)/(d+n) when t > tan(pi/8), so that the Gregory series
-///            (A&S 4.4.42, to u^21) only sees |t| <= tan(pi/8) = 0.4142. Radians become BAM through
-///            2^32/pi, and the octant is unfolded exactly (pi/4 is 2^29 BAM).
+///   sin/cos  The top three BAM bits pick an octant; the 29-bit remainder r (mirrored in odd
+///            octants) is x = r pi/2^31 in [0, pi/4]. Its top 5 bits pick node i of
+///            odo_sin_table_q31 (sin and cos of i pi/128, Q31), the rest is d < pi/128 rad in Q32,
+///            and the angle-sum identities give sin x = S_i cos d + C_i sin d and
+///            cos x = C_i cos d - S_i sin d with 1 - cos d = d^2/2 - d^4/24 and sin d = d - d^3/6
+///            (A&S 4.3.65, 4.3.66 truncated), each product one UMULL; the octant then picks which
+///            of the two answers and its sign. The body is odo_sincos_q30_inline (odo_fx.h).
+///   atan2    The magnitudes fold the vector into the first octant, 0 <= n <= d, scaled to
+///            d <= 2^30 with the ratio kept. One 32-bit division (odo_frac_q32: two UDIVs, no
+///            64-bit division) gives t = n/d in Q32, or u = (d-n)/(d+n) when t > tan(pi/8), so
+///            that the Gregory series (A&S 4.4.42, to u^21, coefficients 1/(2k+1) in Q32) only
+///            sees |t| <= tan(pi/8) = 0.4142. Radians become BAM through 2^32/pi, and the octant
+///            is unfolded exactly (pi/4 is 2^29 BAM).
 ///
-/// Error budget (absolute, on the real value; LSB = 2^-31 = 4.66e-10). Bracketed: the maxima that
-/// tests/unit/test_trig.c measures over 2^20 random inputs per function plus the edge sets
-/// (a sweep of every 13th BAM, and 10^8 random vectors, gave the same figures).
-///   sin/cos  series truncation   x^13/13! resp. x^14/14! at x = pi/4        < 7.0e-12
-///            x rounded to Q31    0.5 LSB, slope <= 1                          2.3e-10
-///            Horner roundings    <= 0.75 LSB per step, earlier steps damped  < 6.1e-10
-///                                by x^2/k(k+1) <= 0.1; final multiply 0.5 LSB
-///            output to Q30       0.5 Q30 LSB = 1 LSB                          4.7e-10
-///            bound                                                            < 1.4e-9  [1.0e-9]
+/// Error budget (absolute, on the real value; Q31 LSB = 4.66e-10, Q32 LSB = 2.33e-10). Bracketed:
+/// the maxima that odo-bench (`sincos_max_abs_err`, `atan2_max_abs_err_rad`) and
+/// tests/unit/test_trig.c measure over 10^6 random inputs plus the edge sets.
+///   sin/cos  series truncation   d^4/720 and d^5/120 at d = pi/128              < 8e-11
+///            table entries       0.5 Q31 LSB each, times |cos d| + |sin d|      2.4e-10
+///            d rounded to Q32    0.5 LSB, slope <= 1                           1.2e-10
+///            1 - cos d, sin d    two truncating products each, 1 Q32 LSB each  < 9.4e-10
+///            the two products    truncated (1 Q31 LSB) and rounded (0.5)       7.0e-10
+///            output to Q30       0.5 Q30 LSB                                    4.7e-10
+///            bound                                                             < 2.5e-9  [1.7e-9]
 ///   atan2    series truncation   u^23/23 at u = 0.4143                        < 7e-11
-///            operands rounded    0.5 each with |(d, n)| >= 2^31: angle moves < 3.3e-10
-///            ratio to Q31        0.5 LSB, slope <= 1                          2.3e-10
-///            Horner and coeffs   0.5 LSB per step damped by u^2 <= 0.172,     < 4.7e-10
-///                                times u <= 0.414, plus the final 0.5 LSB
-///            radians to BAM      half a BAM                                   7.3e-10
-///            bound                                                            < 1.9e-9  [1.4e-9]
+///            operands rounded    0.5 each with d >= 2^29: angle moves         < 1.4e-9
+///            ratio to Q32        0.5 LSB, slope <= 1                          1.2e-10
+///            Horner, truncating  < 1 LSB per step damped by u^2 <= 0.172      < 3.3e-10
+///            radians to BAM      half a BAM plus the constant                 8.0e-10
+///            bound                                                            < 2.8e-9  [1.8e-9]
 ///
-/// Cost on a Cortex-M4 (arm-none-eabi-gcc -O2): sin or cos alone about 16 multiply instructions,
-/// the constant divisions included, and no library calls; sincos about 30; atan2 about 15 plus one
-/// __aeabi_uldivmod. About 1.6 kB of code, no tables, no state, reentrant.
+/// Cost on a Cortex-M4 (arm-none-eabi-gcc -O2, `odo-bench-target --profile`): odo_sincos_q30
+/// about 58 instructions for the pair, odo_sin_q30/odo_cos_q30 the same plus the call;
+/// odo_atan2_bam about 140 plus about 55 in odo_frac_q32 (two UDIVs). One 260-byte table, no
+/// state, no library calls, reentrant.
 
 #include "odo/odo_fx.h"
 
-/// Q31 in unsigned form: 1.0 == 2^31 fits a uint32, so cos(0) and atan's leading 1 are exact.
-#define Q31_ONE ((uint32_t)1U << 31)
-
 /// One octant of a turn in BAM (pi/4), and the mask of the remainder inside an octant.
-#define OCTANT_BAM  ((uint32_t)1U << 29)
-#define OCTANT_MASK (OCTANT_BAM - 1U)
+#define OCTANT_BAM ((uint32_t)1U << 29)
 
-/// round(pi * 2^30). A remainder r of BAM in an octant is r * (pi/4) / 2^29 rad, which in Q31 is
-/// exactly r * pi; r <= 2^29 keeps r * PI_Q30 below 2^61. The constant's own rounding (0.13)
-/// costs < 0.07 LSB at r = 2^29.
+/// round(pi * 2^30). A remainder r of BAM in an octant is r * (pi/4) / 2^29 rad, which in Q32 is
+/// r * 2 pi = r * PI_Q30 / 2^29; r <= 2^29 keeps the product below 2^61.
 #define PI_Q30 3373259426U
 
-/// round(2^32 / pi). rad_q31 * 2^32/pi / 2^32 = rad/(2 pi) * 2^32 = BAM.
+/// round(2^32 / pi): rad_q32 * 2^32/pi / 2^33 = rad / (2 pi) * 2^32 = BAM.
 #define INV_PI_Q32 1367130551U
 
 /// round(tan(pi/8) * 2^31) = round((sqrt(2) - 1) * 2^31). Any value near it works: both branches
 /// of the fold are exact identities, this only caps |u| of the series at 0.4143.
 #define TAN_PI_8_Q31 889516852U
 
-/// round(2^31 / d): the series coefficients 1/(2k+1), computed by the compiler from the integer.
-#define RECIP_Q31(d) ((uint32_t)((Q31_ONE + (uint32_t)(d) / 2U) / (uint32_t)(d)))
+/// round(2^32 / d) for an integer d >= 2, computed by the compiler: the series coefficients 1/k!
+/// (d = k!, at most 12! = 479001600) and 1/(2k+1).
+#define RECIP_Q32(d) ((uint32_t)((((uint64_t)1U << 32) + (uint64_t)(d) / 2U) / (uint64_t)(d)))
 
-/// round(a * b / 2^31) for a, b in [0, 2^31] (Q31); the result stays in [0, 2^31].
-static inline uint32_t mul_q31(uint32_t a, uint32_t b)
+/// floor(a * b / 2^32): one UMULL, the high word.
+static inline uint32_t mulhi(uint32_t a, uint32_t b) { return (uint32_t)(((uint64_t)a * b) >> 32); }
+
+/// round(a * b / 2^32), half up: UMULL and a carry.
+static inline uint32_t mulhi_round(uint32_t a, uint32_t b)
 {
-    return (uint32_t)(((uint64_t)a * b + ((uint64_t)1U << 30)) >> 31);
+    return (uint32_t)(((uint64_t)a * b + 0x80000000ULL) >> 32);
 }
 
-/// One Horner step of a Taylor series with alternating signs: 1 - x^2 * p / d, where d is the
-/// integer k(k+1) that links consecutive factorials (x^(k+1)/(k+1)! = x^(k-1)/(k-1)! * x^2/k(k+1)).
-/// x2 * p / d < 1 for every step used here, so the subtraction cannot wrap. d is a literal at
-/// every call, so after inlining the division is a multiply-high.
-static inline uint32_t horner_step(uint32_t x2_q31, uint32_t p_q31, uint32_t d)
+/// round(sin(i pi / 128) 2^31) for i = 0..64: sin and cos at the 33 nodes of an octant (cos of
+/// node i is entry 64 - i), Q31 in uint32 so that 1.0 (entry 64) is exact. Computed with 60-digit
+/// decimal arithmetic (every value is at least 0.005 LSB from a rounding tie);
+/// tests/unit/test_trig.c checks each entry against libm.
+const uint32_t odo_sin_table_q31[ODO_SIN_TABLE_SIZE] = {
+    0U,          52701887U,   105372028U,  157978697U,  210490206U,  262874923U,  315101295U,  367137861U,  418953276U,
+    470516330U,  521795963U,  572761285U,  623381598U,  673626408U,  723465451U,  772868706U,  821806413U,  870249095U,
+    918167572U,  965532978U,  1012316784U, 1058490808U, 1104027237U, 1148898640U, 1193077991U, 1236538675U, 1279254516U,
+    1321199781U, 1362349204U, 1402678000U, 1442161874U, 1480777044U, 1518500250U, 1555308768U, 1591180426U, 1626093616U,
+    1660027308U, 1692961062U, 1724875040U, 1755750017U, 1785567396U, 1814309216U, 1841958164U, 1868497586U, 1893911494U,
+    1918184581U, 1941302225U, 1963250501U, 1984016189U, 2003586779U, 2021950484U, 2039096241U, 2055013723U, 2069693342U,
+    2083126254U, 2095304370U, 2106220352U, 2115867626U, 2124240380U, 2131333572U, 2137142927U, 2141664948U, 2144896910U,
+    2146836866U, 2147483648U,
+};
+
+void odo_sincos_q30(uint32_t angle_bam, int32_t *sin_q30, int32_t *cos_q30)
 {
-    return Q31_ONE - (mul_q31(x2_q31, p_q31) + d / 2U) / d;
+    odo_sincos_q30_inline(angle_bam, sin_q30, cos_q30);
 }
 
-/// sin x for x in [0, pi/4] (Q31 in and out):
-/// x (1 - x^2/(2*3) (1 - x^2/(4*5) (1 - x^2/(6*7) (1 - x^2/(8*9) (1 - x^2/(10*11)))))).
-static uint32_t sin_poly_q31(uint32_t x_q31)
+uint64_t odo_sincos_pair_q30(uint32_t angle_bam)
 {
-    const uint32_t x2 = mul_q31(x_q31, x_q31);
-    uint32_t p = Q31_ONE;
-    p = horner_step(x2, p, 10U * 11U);
-    p = horner_step(x2, p, 8U * 9U);
-    p = horner_step(x2, p, 6U * 7U);
-    p = horner_step(x2, p, 4U * 5U);
-    p = horner_step(x2, p, 2U * 3U);
-    return mul_q31(x_q31, p);
-}
-
-/// cos x for x in [0, pi/4] (Q31 in and out):
-/// 1 - x^2/(1*2) (1 - x^2/(3*4) (1 - x^2/(5*6) (1 - x^2/(7*8) (1 - x^2/(9*10)
-///   (1 - x^2/(11*12)))))).
-static uint32_t cos_poly_q31(uint32_t x_q31)
-{
-    const uint32_t x2 = mul_q31(x_q31, x_q31);
-    uint32_t p = Q31_ONE;
-    p = horner_step(x2, p, 11U * 12U);
-    p = horner_step(x2, p, 9U * 10U);
-    p = horner_step(x2, p, 7U * 8U);
-    p = horner_step(x2, p, 5U * 6U);
-    p = horner_step(x2, p, 3U * 4U);
-    return horner_step(x2, p, 1U * 2U);
-}
-
-/// Splits a BAM into its octant (0..7) and the distance x in [0, pi/4] (Q31) from the nearest
-/// axis-or-diagonal that makes the octant's identity a plain sin/cos of x. Even octants measure
-/// from their start (theta = o pi/4 + x); odd octants from their end (theta = (o+1) pi/4 - x),
-/// so r == 0 in an odd octant gives x = pi/4, the same point reached from the other side.
-static uint32_t fold_octant_q31(uint32_t angle_bam, uint32_t *octant)
-{
-    const uint32_t oct = angle_bam >> 29;
-    uint32_t r = angle_bam & OCTANT_MASK;
-    if ((oct & 1U) != 0U) {
-        r = OCTANT_BAM - r;
-    }
-    *octant = oct;
-    return (uint32_t)(((uint64_t)r * PI_Q30 + ((uint64_t)1U << 29)) >> 30);
-}
-
-/// With theta written as above, sin theta is +-cos x in octants 1, 2, 5, 6 (theta within pi/4 of
-/// +-pi/2) and +-sin x elsewhere; it is negative in octants 4..7. cos theta takes the other
-/// polynomial and is negative in octants 2..5. Hence cos(a) == sin(a + quarter) bit for bit.
-static bool octant_swaps(uint32_t oct) { return ((oct + 1U) & 2U) != 0U; }
-static bool octant_sin_negative(uint32_t oct) { return oct >= 4U; }
-static bool octant_cos_negative(uint32_t oct) { return ((oct + 2U) & 4U) != 0U; }
-
-/// Q31 magnitude in [0, 2^31] to signed Q30, rounding the magnitude half away from zero.
-static int32_t signed_q30(uint32_t mag_q31, bool negative)
-{
-    const int32_t v = (int32_t)((mag_q31 + 1U) >> 1);
-    return negative ? -v : v;
+    int32_t s, c;
+    odo_sincos_q30_inline(angle_bam, &s, &c);
+    return (uint64_t)(uint32_t)s | ((uint64_t)(uint32_t)c << 32);
 }
 
 int32_t odo_sin_q30(uint32_t angle_bam)
 {
-    uint32_t oct;
-    const uint32_t x = fold_octant_q31(angle_bam, &oct);
-    const uint32_t mag = octant_swaps(oct) ? cos_poly_q31(x) : sin_poly_q31(x);
-    return signed_q30(mag, octant_sin_negative(oct));
+    int32_t s, c;
+    odo_sincos_q30(angle_bam, &s, &c);
+    return s;
 }
 
 int32_t odo_cos_q30(uint32_t angle_bam)
 {
-    // cos a = sin(a + pi/2); BAM addition wraps exactly, so no extra rounding.
-    return odo_sin_q30((uint32_t)(angle_bam + (uint32_t)ODO_BAM_QUARTER));
+    int32_t s, c;
+    odo_sincos_q30(angle_bam, &s, &c);
+    return c;
 }
 
-void odo_sincos_q30(uint32_t angle_bam, int32_t *sin_q30, int32_t *cos_q30)
-{
-    uint32_t oct;
-    const uint32_t x = fold_octant_q31(angle_bam, &oct);
-    const uint32_t s = sin_poly_q31(x);
-    const uint32_t c = cos_poly_q31(x);
-    const bool swap = octant_swaps(oct);
-    *sin_q30 = signed_q30(swap ? c : s, octant_sin_negative(oct));
-    *cos_q30 = signed_q30(swap ? s : c, octant_cos_negative(oct));
-}
-
-/// atan u for u in [0, 0.4143] (Q31 in, radians Q31 out):
-/// u (1 - u^2 (1/3 - u^2 (1/5 - ... u^2 (1/19 - u^2/21)))). Every bracket is positive because
+/// atan u for u in [0, 0.4143] (Q32 in, radians Q32 out): u - u^3/3 + ... + u^21/21, as
+/// u - u (u^2 (1/3 - u^2 (1/5 - ... u^2 (1/19 - u^2/21)))). Every bracket is positive because
 /// u^2 < 1 and 1/(2k+3) < 1/(2k+1), so the whole evaluation stays unsigned.
-static uint32_t atan_poly_q31(uint32_t u_q31)
+static uint32_t atan_poly_q32(uint32_t u)
 {
-    const uint32_t u2 = mul_q31(u_q31, u_q31);
-    uint32_t p = RECIP_Q31(21);
-    p = RECIP_Q31(19) - mul_q31(u2, p);
-    p = RECIP_Q31(17) - mul_q31(u2, p);
-    p = RECIP_Q31(15) - mul_q31(u2, p);
-    p = RECIP_Q31(13) - mul_q31(u2, p);
-    p = RECIP_Q31(11) - mul_q31(u2, p);
-    p = RECIP_Q31(9) - mul_q31(u2, p);
-    p = RECIP_Q31(7) - mul_q31(u2, p);
-    p = RECIP_Q31(5) - mul_q31(u2, p);
-    p = RECIP_Q31(3) - mul_q31(u2, p);
-    p = Q31_ONE - mul_q31(u2, p);
-    return mul_q31(u_q31, p);
+    const uint32_t u2 = mulhi_round(u, u);
+    uint32_t p = RECIP_Q32(21U);
+    p = RECIP_Q32(19U) - mulhi(u2, p);
+    p = RECIP_Q32(17U) - mulhi(u2, p);
+    p = RECIP_Q32(15U) - mulhi(u2, p);
+    p = RECIP_Q32(13U) - mulhi(u2, p);
+    p = RECIP_Q32(11U) - mulhi(u2, p);
+    p = RECIP_Q32(9U) - mulhi(u2, p);
+    p = RECIP_Q32(7U) - mulhi(u2, p);
+    p = RECIP_Q32(5U) - mulhi(u2, p);
+    p = RECIP_Q32(3U) - mulhi(u2, p);
+    return u - mulhi_round(u, mulhi_round(u2, p));
 }
 
-/// Radians in [0, pi/8] (Q31) to BAM, rounded to nearest.
-static uint32_t rad_q31_to_bam(uint32_t rad_q31)
+/// max(0, bit_length(v) - 30): the right shift that brings v to at most 2^30. Five fixed steps
+/// on the high word, then the low word's top bits.
+static unsigned excess_bits_over_30(uint64_t v)
 {
-    return (uint32_t)(((uint64_t)rad_q31 * INV_PI_Q32 + ((uint64_t)1U << 31)) >> 32);
-}
-
-/// max(0, bit_length(v) - 32): the right shift that brings v below 2^32. Five fixed steps.
-static unsigned excess_bits_over_32(uint64_t v)
-{
-    uint32_t h = (uint32_t)(v >> 32);
+    uint32_t h = (uint32_t)(v >> 30);
     unsigned n = 0U;
+    if ((v >> 62) != 0U) {
+        return 33U + (unsigned)(v >> 63);
+    }
     if (h >= ((uint32_t)1U << 16)) {
         h >>= 16;
         n += 16U;
@@ -207,7 +158,7 @@ static unsigned excess_bits_over_32(uint64_t v)
     return n + (unsigned)h;
 }
 
-/// v / 2^s rounded to nearest, s in [0, 32]; v <= 2^63 so the bias cannot overflow.
+/// v / 2^s rounded half up, s in [0, 34]; v <= 2^63 so the bias cannot overflow.
 static uint64_t shr_round_u64(uint64_t v, unsigned s) { return s == 0U ? v : (v + ((uint64_t)1U << (s - 1U))) >> s; }
 
 uint32_t odo_atan2_bam(int64_t y, int64_t x)
@@ -219,25 +170,24 @@ uint32_t odo_atan2_bam(int64_t y, int64_t x)
     // First octant: angle phi = atan(n/d) in [0, pi/4]; "steep" vectors are mirrored about
     // the diagonal (phi' = pi/2 - phi).
     const bool steep = uy > ux;
-    uint64_t n = steep ? ux : uy;
-    uint64_t d = steep ? uy : ux;
-    if (d == 0U) {
+    uint64_t n64 = steep ? ux : uy;
+    uint64_t d64 = steep ? uy : ux;
+    if (d64 == 0U) {
         return 0U;
     }
 
-    // A common rounding shift keeps the ratio while bringing d to at most 2^32, so n << 31 and
-    // (d - n) << 31 fit 64 bits. Once shifted d >= 2^31, so the ratio moves by < 2^-31.
-    const unsigned s = excess_bits_over_32(d);
-    n = shr_round_u64(n, s);
-    d = shr_round_u64(d, s);
+    // A common rounding shift keeps the ratio while bringing d to at most 2^30, so d + n fits
+    // 32 bits. Once shifted d >= 2^29, so the direction moves by < 1.4e-9 rad.
+    const unsigned s = excess_bits_over_30(d64);
+    const uint32_t n = (uint32_t)shr_round_u64(n64, s);
+    const uint32_t d = (uint32_t)shr_round_u64(d64, s);
 
     // Past tan(pi/8) use tan(pi/4 - phi) = (1 - t)/(1 + t) = (d - n)/(d + n), which is then
     // below tan(pi/8) too. Choosing the operands first keeps it to one division.
-    const bool reflect = n * Q31_ONE > d * TAN_PI_8_Q31;
-    const uint64_t num = reflect ? (d - n) * Q31_ONE : n * Q31_ONE;
-    const uint64_t den = reflect ? d + n : d;
-    const uint32_t ratio_q31 = (uint32_t)((num + den / 2U) / den);
-    const uint32_t atan_bam = rad_q31_to_bam(atan_poly_q31(ratio_q31));
+    const bool reflect = ((uint64_t)n << 31) > (uint64_t)d * TAN_PI_8_Q31;
+    const uint32_t ratio_q32 = reflect ? odo_frac_q32(d - n, d + n) : odo_frac_q32(n, d);
+    const uint32_t atan_q32 = atan_poly_q32(ratio_q32);
+    const uint32_t atan_bam = (uint32_t)(((uint64_t)atan_q32 * INV_PI_Q32 + ((uint64_t)1U << 32)) >> 33);
     const uint32_t phi_bam = reflect ? OCTANT_BAM - atan_bam : atan_bam;
 
     // Unfold: octant -> quadrant I -> quadrant by the signs. BAM arithmetic wraps mod 2 pi.

@@ -19,11 +19,14 @@ from pathlib import Path
 import cantools
 import pytest
 from cantools.database.can import Database, Message, Signal
+from odo_tools import cangen
 
 SOURCE_DIR = Path(os.environ.get("ODO_SOURCE_DIR", Path(__file__).resolve().parents[2]))
 DBC_PATH = SOURCE_DIR / "can" / "odometry.dbc"
-HEADER_PATH = SOURCE_DIR / "firmware" / "include" / "odo" / "odo_can.h"
+GENERATED_HEADER_PATH = SOURCE_DIR / "firmware" / "include" / "odo" / "odo_can_dbc.h"
 N_RANDOM = 200  # random vectors per message, on top of the limit vectors
+FLAG_SIGNALS = ("Missing", "Jump", "Ipec", "IpecGated", "Range", "XySaturated", "FlagsReserved")
+FLAGS_CLEAR = dict.fromkeys(FLAG_SIGNALS, 0)
 SEED = 0x0D0CA7
 
 
@@ -185,14 +188,18 @@ def test_dbc_loads_in_strict_mode_without_warnings(caplog: pytest.LogCaptureFixt
 
 
 def test_dbc_frames_are_classic_intel_integer_and_documented(db: Database) -> None:
-    assert {n.name for n in db.nodes} == {"SENSOR", "ODO"}
+    assert {n.name for n in db.nodes} == {"SENSOR", "ODO", "NAV"}
+    assert all(n.comment for n in db.nodes)
     for msg in db.messages:
         assert not msg.is_extended_frame and msg.frame_id <= 0x7FF, msg.name
         assert not msg.is_fd and msg.length in (6, 8), msg.name
         assert msg.cycle_time == 40, msg.name
-        assert msg.senders == (["SENSOR"] if msg.frame_id < 0x180 else ["ODO"]), msg.name
+        sensor = msg.frame_id < 0x180
+        assert msg.senders == (["SENSOR"] if sensor else ["ODO"]), msg.name
         assert msg.comment, f"{msg.name} has no CM_ comment"
         for sig in msg.signals:
+            # every frame is received by someone named: the firmware, or the pose consumers
+            assert sig.receivers == (["ODO"] if sensor else ["NAV"]), (msg.name, sig.name)
             assert sig.byte_order == "little_endian", (msg.name, sig.name)
             assert not sig.is_float and sig.offset == 0, (msg.name, sig.name)
             assert sig.comment, f"{msg.name}.{sig.name} has no CM_ comment"
@@ -213,8 +220,33 @@ def test_every_dbc_message_and_signal_has_a_c_counterpart_and_vice_versa(db: Dat
         assert cm.signals == dbc_sigs, msg.name
 
 
+def test_generated_codec_is_what_the_dbc_gives() -> None:
+    """odo_can_dbc.h / odo_can_dbc.c are generated from the DBC (tools/python/odo_tools/cangen.py)
+    and committed: regenerating them gives the committed files byte for byte."""
+    files = cangen.generate(DBC_PATH)
+    assert set(files) == {cangen.HEADER_REL, cangen.SOURCE_REL}
+    for rel, text in files.items():
+        committed = (SOURCE_DIR / rel).read_text()
+        assert committed == text, f"{rel} is out of date: run .venv/bin/python -m odo_tools.cangen"
+
+
+def test_cangen_check_reports_a_stale_file(tmp_path: Path) -> None:
+    """`cangen --check` fails (exit 1, a diff) on a tree whose generated file differs, and
+    writes nothing; without --check it renames fresh files into place."""
+    (tmp_path / "can").mkdir()
+    (tmp_path / "can" / "odometry.dbc").write_text(DBC_PATH.read_text())
+    assert cangen.main(["--source-dir", str(tmp_path), "--check"]) == 1
+    assert not (tmp_path / cangen.HEADER_REL).exists()
+    assert cangen.main(["--source-dir", str(tmp_path)]) == 0
+    assert cangen.main(["--source-dir", str(tmp_path), "--check"]) == 0
+    stale = tmp_path / cangen.SOURCE_REL
+    stale.write_text(stale.read_text() + "/* edited */\n")
+    assert cangen.main(["--source-dir", str(tmp_path), "--check"]) == 1
+    assert cangen.main(["--source-dir", str(tmp_path / "nowhere"), "--check"]) == 2
+
+
 def test_header_macros_match_the_dbc(db: Database) -> None:
-    text = HEADER_PATH.read_text()
+    text = GENERATED_HEADER_PATH.read_text()
     macros = {
         name: int(value, 16)
         for name, value in re.findall(r"#define ODO_CAN_ID_(\w+)\s+0x([0-9A-Fa-f]+)U", text)
@@ -262,8 +294,8 @@ def test_cantools_encoding_decodes_identically_with_c(db: Database) -> None:
     [
         ("POSE_XY_A", {"X": 12345, "Y": -12345}, {"X": 123.45, "Y": -123.45}, "mm"),
         ("POSE_XY_B", {"X": -(2**31), "Y": 2**31 - 1}, {"X": -21474836.48, "Y": 21474836.47}, "mm"),
-        ("POSE_THETA_A", {"Theta": 2**30, "Seq": 0, "Flags": 0}, {"Theta": 90.0}, "deg"),
-        ("POSE_THETA_B", {"Theta": 2**31, "Seq": 1, "Flags": 0}, {"Theta": 180.0}, "deg"),
+        ("POSE_THETA_A", {"Theta": 2**30, "Seq": 0, **FLAGS_CLEAR}, {"Theta": 90.0}, "deg"),
+        ("POSE_THETA_B", {"Theta": 2**31, "Seq": 1, **FLAGS_CLEAR}, {"Theta": 180.0}, "deg"),
         (
             "LINK_ROTARY",
             {"Alpha": 2**14, "Beta": 2**16 - 1, "Seq": 2, "Status": 3},
@@ -315,8 +347,14 @@ def header_bits(path: Path, pattern: str) -> dict[int, str]:
     return bits
 
 
-def documented_bits(text: str) -> dict[int, str]:
-    return {int(i): name for i, name in re.findall(r"\bbit(\d+) ([A-Z][A-Z0-9_]+)", text)}
+def snake(camel: str) -> str:
+    """A DBC signal name as its C macro suffix: CounterJumpA -> COUNTER_JUMP_A."""
+    return re.sub(r"(?<=[a-z0-9])(?=[A-Z])", "_", camel).upper()
+
+
+def bit_signals(msg: Message, base: int) -> dict[int, str]:
+    """Bit index (from `base`) -> C-style name of every one-bit signal of msg."""
+    return {s.start - base: snake(s.name) for s in msg.signals if s.length == 1}
 
 
 def readme_bits(table_header: str) -> dict[int, str]:
@@ -325,22 +363,38 @@ def readme_bits(table_header: str) -> dict[int, str]:
     return {int(i): name for i, name in re.findall(r"^\| (\d+) \| ([A-Z0-9_]+) \|", table, re.M)}
 
 
-def test_fault_and_flag_bits_are_documented_as_the_headers_define_them(db: Database) -> None:
-    """One source per contract: the bit names and positions of STATUS.Faults (odo_status.h) and
-    POSE_THETA.Flags (odo_app.h) are what the DBC's comments and can/README.md say they are."""
+def test_fault_and_flag_bits_are_named_signals_as_the_headers_define_them(db: Database) -> None:
+    """One source per contract, and names for cantools: every STATUS fault bit (odo_status.h) and
+    every POSE_THETA flag bit (odo_app.h) is a one-bit signal of the same name at the same
+    position, the rest of the word a reserved signal; can/README.md's tables say the same."""
     include = SOURCE_DIR / "firmware" / "include" / "odo"
     faults = header_bits(include / "odo_status.h", r"#define ODO_FAULT_(\w+)\s+\(1UL << (\d+)\)")
     flags = header_bits(include / "odo_app.h", r"#define ODO_POSE_FLAG_(\w+)\s+(0x[0-9A-Fa-f]+)U")
     count = re.search(r"#define ODO_FAULT_COUNT (\d+)U", (include / "odo_status.h").read_text())
     assert count is not None and len(faults) == int(count.group(1))
     assert faults and flags
-    status = db.get_message_by_name("STATUS").get_signal_by_name("Faults")
-    assert documented_bits(status.comment) == faults
-    assert readme_bits("| Faults bit | name |") == faults
+    status = db.get_message_by_name("STATUS")
+    assert bit_signals(status, 0) == faults
+    reserved = status.get_signal_by_name("FaultsReserved")
+    assert (reserved.start, reserved.start + reserved.length) == (len(faults), 32)
     for msg in ("POSE_THETA_A", "POSE_THETA_B"):
-        comment = db.get_message_by_name(msg).get_signal_by_name("Flags").comment
-        assert documented_bits(comment) == flags
+        theta = db.get_message_by_name(msg)
+        assert bit_signals(theta, 40) == flags
+        reserved = theta.get_signal_by_name("FlagsReserved")
+        assert (reserved.start, reserved.start + reserved.length) == (40 + len(flags), 48)
+    assert readme_bits("| Faults bit | name |") == faults
     assert readme_bits("| Flags bit | name |") == flags
+
+
+def test_cantools_names_the_faults_of_a_status_frame(db: Database) -> None:
+    """What `cantools decode` prints for a STATUS frame: each raised fault by name."""
+    status = db.get_message_by_name("STATUS")
+    data = bytes.fromhex("2022000007050300")  # faults 0x2220: SEQ_GAP, LINK_MISSING, IPEC_GATED
+    decoded = status.decode(data)
+    one_bit = {s.name for s in status.signals if s.length == 1}
+    raised = sorted(name for name, v in decoded.items() if name in one_bit and v == 1)
+    assert raised == ["IpecGated", "LinkMissing", "SeqGap"]
+    assert str(decoded["ParamState"]) == "ERR_CRC"
 
 
 # ---- odo-canvec's own contract (the batch must survive bad lines) ----

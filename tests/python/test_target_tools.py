@@ -110,7 +110,7 @@ def test_instruction_lengths_match_the_disassembler() -> None:
     fw = emu.Firmware(elf, [])
     row = re.compile(r"^\s+([0-9a-f]+):\s+((?:[0-9a-f]{4} ?){1,2})\s+(\S+)")
     checked = 0
-    for name in ("odo_app_step", "odo_truck_step", "odo_ipec_step", "odo_atan2_bam"):
+    for name in ("odo_app_step", "odo_truck_tick", "odo_ipec_step", "odo_atan2_bam"):
         addr, size = fw.symbols[name]
         addr &= ~1
         dis = run("arm-none-eabi-objdump", "-d", f"--start-address={addr}",
@@ -126,3 +126,23 @@ def test_instruction_lengths_match_the_disassembler() -> None:
                 assert emu.thumb_instructions(code[:2] + b"\x00\xbf") == 1, line  # 32-bit
             checked += 1
     assert checked > 500
+
+
+def test_profile_shares_add_up_to_the_tick_counts(tmp_path: Path) -> None:
+    """odo-bench-target --profile: each function's own instructions per tick add up to the
+    measured mean and to the worst tick's count, every share is a function of the ELF, and
+    odo_app_step's own share is there (it is what the budget measures from)."""
+    log = tmp_path / "run.log"
+    log.write_text(LOG_LINES)
+    out = tmp_path / "t.bin"
+    r = run(TICKS, "--log", log, "--robot", ROBOT, "--ipec", "paper", "--out", out)
+    assert r.returncode == 0, r.stderr
+    elf = CM4 / "odo_bench_cm4.elf"
+    block, ticks = bench.read_ticks(out, bench.record_sizes(elf))
+    prof: dict = {}
+    _, counts, differ = bench.emulate(elf, block, ticks, None, prof)
+    assert not differ and len(counts) == 2
+    assert abs(sum(prof["mean"].values()) - sum(counts) / len(counts)) < 0.5
+    assert sum(prof["worst"].values()) == max(counts)
+    symbols = emu.Firmware(elf, []).symbols
+    assert set(prof["mean"]) <= set(symbols) and "odo_app_step" in prof["mean"]

@@ -97,6 +97,32 @@ static void translational_correction_is_against_travel_for_either_wheel_and_sign
     TEST_ASSERT_EQUAL_INT64(pose_at(1, 2, 3).x_mm_q32, still.x_mm_q32);
 }
 
+/// 002 Eq. 14's chord b |sin(dtheta/2)| within 4e-9 b of the double value over corrections from
+/// one BAM to half a turn either way (a small-angle series below 5.6 deg, the sine table above;
+/// the bound adds the Q30 sin/cos of the shift's direction and the nm conversion): the length
+/// of the shift is the chord.
+static void translational_correction_chord_matches_the_sine_over_every_correction_size(void)
+{
+    const uint32_t b_nm = 1000000000U; /* 1 m: the shift in mm is 1000 |sin(dtheta/2)| */
+    double worst = 0.0;
+    for (uint32_t k = 0U; k < 4096U; ++k) {
+        /* geometric sweep from 1 BAM to 2^31 - 1, both signs, the series' edge 2^27 included */
+        const double t = (double)k / 4095.0;
+        int64_t mag = llround(pow(2.0, 31.0 * t));
+        mag = mag > INT32_MAX ? INT32_MAX : mag;
+        const int32_t dth[3] = {(int32_t)mag, (int32_t)-mag, (int32_t)(((uint32_t)1U << 27) - 2U + (k & 3U))};
+        for (unsigned j = 0U; j < 3U; ++j) {
+            odo_pose_t p = pose_at(0, 0, 0);
+            int64_t dx = 0, dy = 0;
+            odo_ipec_translate(&p, dth[j], (int64_t)1 << 40, b_nm, &dx, &dy);
+            const double half_rad = (double)(dth[j] / 2) * (2.0 * M_PI / 4294967296.0);
+            const double err = fabs(hypot(mm(dx), mm(dy)) - 1000.0 * fabs(sin(half_rad))) / 1000.0;
+            worst = err > worst ? err : worst;
+        }
+    }
+    TEST_ASSERT_TRUE(worst < 4e-9);
+}
+
 /// The estimator: beyond half a rotary step the correction is immediate (bumps); within it only
 /// 2^-ODO_IPEC_EST_PULL_SHIFT per tick. PAPER passes everything; OFF nothing.
 static void estimator_keeps_bumps_immediate_and_filters_within_a_step(void)
@@ -342,6 +368,7 @@ int main(void)
     RUN_TEST(eq10_from_b_to_a_makes_eq16_put_b_l_behind_a);
     RUN_TEST(paper_form_corrects_a_heading_error_within_the_tick);
     RUN_TEST(translational_correction_is_against_travel_for_either_wheel_and_sign);
+    RUN_TEST(translational_correction_chord_matches_the_sine_over_every_correction_size);
     RUN_TEST(estimator_keeps_bumps_immediate_and_filters_within_a_step);
     RUN_TEST(set_trailer_correction_accounts_for_the_hitch_lever);
     RUN_TEST(corrections_reach_the_ipec_corr_frame);

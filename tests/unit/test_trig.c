@@ -43,8 +43,8 @@ static void report(const char *what, double max_err, unsigned long n)
     TEST_MESSAGE(msg);
 }
 
-/// A&S 4.3.65/4.3.66: the truncated series, folded to [0, pi/4], meets 2e-8 everywhere on the
-/// circle. Uniform random BAMs sample every octant and every remainder bit.
+/// The table plus A&S 4.3.65/4.3.66's short series on the remainder, folded to [0, pi/4], meets
+/// 2e-8 everywhere on the circle. Uniform random BAMs sample every octant and every remainder bit.
 static void test_sin_cos_within_2e8_over_a_million_random_angles(void)
 {
     ts_rng_t rng;
@@ -60,6 +60,19 @@ static void test_sin_cos_within_2e8_over_a_million_random_angles(void)
     report("cos", worst_cos, RANDOM_INPUTS);
     TEST_ASSERT_LESS_OR_EQUAL_DOUBLE(SINCOS_BOUND, worst_sin);
     TEST_ASSERT_LESS_OR_EQUAL_DOUBLE(SINCOS_BOUND, worst_cos);
+}
+
+/// The node table behind sin/cos (odo_sin_table_q31): entry i is round(sin(i pi / 128) 2^31) for
+/// i = 0..64, computed here with libm (each entry is at least 0.005 LSB from a rounding tie, far
+/// beyond libm's error), and entry 64 is exactly 1.0.
+static void test_sin_table_entries_are_the_rounded_sines(void)
+{
+    TEST_ASSERT_EQUAL_UINT32(65U, ODO_SIN_TABLE_SIZE);
+    for (uint32_t i = 0U; i < ODO_SIN_TABLE_SIZE; i++) {
+        const double want = floor(sin((double)i * (TWO_PI / 256.0)) * 2147483648.0 + 0.5);
+        TEST_ASSERT_EQUAL_UINT32((uint32_t)want, odo_sin_table_q31[i]);
+    }
+    TEST_ASSERT_EQUAL_UINT32(1UL << 31, odo_sin_table_q31[64]);
 }
 
 /// The octant fold: every boundary k * pi/4 (k = 0..8, so 0 and UINT32_MAX are both hit) and
@@ -338,6 +351,7 @@ static void test_atan2_recovers_the_angle_of_sincos(void)
 int main(void)
 {
     UNITY_BEGIN();
+    RUN_TEST(test_sin_table_entries_are_the_rounded_sines);
     RUN_TEST(test_sin_cos_within_2e8_over_a_million_random_angles);
     RUN_TEST(test_sin_cos_within_2e8_at_and_around_every_octant_boundary);
     RUN_TEST(test_sin_cos_are_exact_on_the_axes);

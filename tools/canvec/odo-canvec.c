@@ -19,8 +19,8 @@
 #include "odo/odo_can.h"
 
 #define LINE_MAX_CHARS     1024
-#define MAX_TOKENS         16
-#define MAX_SIGNALS        8
+#define MAX_SIGNALS        ODO_CAN_MAX_SIGNALS
+#define MAX_TOKENS         (MAX_SIGNALS + 8)
 #define CAN_ERR_FLAG_IN_ID 0x20000000UL
 
 static const char usage_text[] =
@@ -137,126 +137,6 @@ static const odo_can_msg_info_t *find_msg(const char *name, odo_can_msg_t *which
     return NULL;
 }
 
-static uint8_t truck_of(odo_can_msg_t m)
-{
-    return (m == ODO_CAN_MSG_WHEEL_COUNTS_B || m == ODO_CAN_MSG_POSE_XY_B || m == ODO_CAN_MSG_POSE_THETA_B)
-               ? (uint8_t)ODO_TRUCK_B
-               : (uint8_t)ODO_TRUCK_A;
-}
-
-/* ---- struct <-> raw values in DBC signal order, through the typed firmware API ---- */
-
-static void pack_values(odo_can_msg_t m, const int64_t *v, odo_can_frame_t *f)
-{
-    switch (m) {
-    case ODO_CAN_MSG_WHEEL_COUNTS_A:
-    case ODO_CAN_MSG_WHEEL_COUNTS_B: {
-        odo_msg_wheel_counts_t s = {(uint32_t)v[0], (uint32_t)v[1], (uint8_t)v[2], (uint8_t)v[3]};
-        odo_can_pack_wheel_counts(truck_of(m), &s, f);
-        break;
-    }
-    case ODO_CAN_MSG_LINK_ROTARY: {
-        odo_msg_link_rotary_t s = {(uint16_t)v[0], (uint16_t)v[1], (uint8_t)v[2], (uint8_t)v[3]};
-        odo_can_pack_link_rotary(&s, f);
-        break;
-    }
-    case ODO_CAN_MSG_LINK_LINEAR: {
-        odo_msg_link_linear_t s = {(uint32_t)v[0], (uint8_t)v[1], (uint8_t)v[2]};
-        odo_can_pack_link_linear(&s, f);
-        break;
-    }
-    case ODO_CAN_MSG_POSE_XY_A:
-    case ODO_CAN_MSG_POSE_XY_B: {
-        odo_msg_pose_xy_t s = {(int32_t)v[0], (int32_t)v[1]};
-        odo_can_pack_pose_xy(truck_of(m), &s, f);
-        break;
-    }
-    case ODO_CAN_MSG_POSE_THETA_A:
-    case ODO_CAN_MSG_POSE_THETA_B: {
-        odo_msg_pose_theta_t s = {(uint32_t)v[0], (uint8_t)v[1], (uint8_t)v[2]};
-        odo_can_pack_pose_theta(truck_of(m), &s, f);
-        break;
-    }
-    case ODO_CAN_MSG_IPEC_CORR: {
-        odo_msg_ipec_corr_t s = {(int32_t)v[0], (int32_t)v[1]};
-        odo_can_pack_ipec_corr(&s, f);
-        break;
-    }
-    case ODO_CAN_MSG_STATUS: {
-        odo_msg_status_t s = {(uint32_t)v[0], (uint8_t)v[1], (uint8_t)v[2], (uint16_t)v[3]};
-        odo_can_pack_status(&s, f);
-        break;
-    }
-    case ODO_CAN_MSG_UNKNOWN:
-    default: break;
-    }
-}
-
-/* Unpack with the unpacker of message m; on OK also checks that the truck index matches m. */
-static odo_can_result_t unpack_values(odo_can_msg_t m, const odo_can_frame_t *f, int64_t *v)
-{
-    odo_can_result_t r = ODO_CAN_ERR_ID;
-    uint8_t truck = 0xFFU;
-    switch (m) {
-    case ODO_CAN_MSG_WHEEL_COUNTS_A:
-    case ODO_CAN_MSG_WHEEL_COUNTS_B: {
-        odo_msg_wheel_counts_t s = {0};
-        r = odo_can_unpack_wheel_counts(f, &truck, &s);
-        v[0] = s.left_count, v[1] = s.right_count, v[2] = s.seq, v[3] = s.status;
-        break;
-    }
-    case ODO_CAN_MSG_LINK_ROTARY: {
-        odo_msg_link_rotary_t s = {0};
-        r = odo_can_unpack_link_rotary(f, &s);
-        v[0] = s.alpha_bam16, v[1] = s.beta_bam16, v[2] = s.seq, v[3] = s.status;
-        truck = ODO_TRUCK_A;
-        break;
-    }
-    case ODO_CAN_MSG_LINK_LINEAR: {
-        odo_msg_link_linear_t s = {0};
-        r = odo_can_unpack_link_linear(f, &s);
-        v[0] = s.length_um, v[1] = s.seq, v[2] = s.status;
-        truck = ODO_TRUCK_A;
-        break;
-    }
-    case ODO_CAN_MSG_POSE_XY_A:
-    case ODO_CAN_MSG_POSE_XY_B: {
-        odo_msg_pose_xy_t s = {0};
-        r = odo_can_unpack_pose_xy(f, &truck, &s);
-        v[0] = s.x_10um, v[1] = s.y_10um;
-        break;
-    }
-    case ODO_CAN_MSG_POSE_THETA_A:
-    case ODO_CAN_MSG_POSE_THETA_B: {
-        odo_msg_pose_theta_t s = {0};
-        r = odo_can_unpack_pose_theta(f, &truck, &s);
-        v[0] = s.theta_bam, v[1] = s.seq, v[2] = s.flags;
-        break;
-    }
-    case ODO_CAN_MSG_IPEC_CORR: {
-        odo_msg_ipec_corr_t s = {0};
-        r = odo_can_unpack_ipec_corr(f, &s);
-        v[0] = s.dtheta_a_bam, v[1] = s.dtheta_b_bam;
-        truck = ODO_TRUCK_A;
-        break;
-    }
-    case ODO_CAN_MSG_STATUS: {
-        odo_msg_status_t s = {0};
-        r = odo_can_unpack_status(f, &s);
-        v[0] = s.faults, v[1] = s.seq, v[2] = s.param_state, v[3] = s.rejected;
-        truck = ODO_TRUCK_A;
-        break;
-    }
-    case ODO_CAN_MSG_UNKNOWN:
-    default: break;
-    }
-    /* On error v[] holds zeros (the codec left the struct alone); only r matters. */
-    if (r == ODO_CAN_OK && truck != truck_of(m)) {
-        r = ODO_CAN_ERR_ID;
-    }
-    return r;
-}
-
 /* ---- commands ---- */
 
 static const char *frame_kind(const odo_can_frame_t *f)
@@ -322,7 +202,7 @@ static void cmd_encode(char **tok, int n)
         }
     }
     odo_can_frame_t f;
-    pack_values(m, v, &f);
+    (void)odo_can_pack_signals(m, v, &f);
     printf("%03" PRIX32 "#", f.id);
     for (unsigned i = 0U; i < f.dlc; i++) {
         printf("%02X", f.data[i]);
@@ -423,7 +303,7 @@ static void cmd_decode(char **tok, int n)
     }
     const odo_can_msg_info_t *info = odo_can_msg_info(m);
     int64_t v[MAX_SIGNALS] = {0};
-    odo_can_result_t r = unpack_values(m, &f, v);
+    odo_can_result_t r = odo_can_unpack_signals(m, &f, v);
     switch (r) {
     case ODO_CAN_OK:
         printf("%s", info->name);

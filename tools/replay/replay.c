@@ -111,7 +111,7 @@ static void take(replay_t *r, const odo_can_frame_t *f)
     }
     bool stale = false;
     if (m == ODO_CAN_MSG_LINK_ROTARY) {
-        odo_msg_link_rotary_t lr;
+        odo_msg_link_rotary_t lr = {0};
         (void)odo_can_unpack_link_rotary(f, &lr);
         stale = in->link.rotary_present && !newer(in->link.rotary_seq, lr.seq);
         if (!stale) {
@@ -122,7 +122,7 @@ static void take(replay_t *r, const odo_can_frame_t *f)
             in->link.beta_bam16 = lr.beta_bam16;
         }
     } else if (m == ODO_CAN_MSG_LINK_LINEAR) {
-        odo_msg_link_linear_t ll;
+        odo_msg_link_linear_t ll = {0};
         (void)odo_can_unpack_link_linear(f, &ll);
         stale = in->link.linear_present && !newer(in->link.linear_seq, ll.seq);
         if (!stale) {
@@ -133,7 +133,7 @@ static void take(replay_t *r, const odo_can_frame_t *f)
         }
     } else {
         uint8_t truck = 0U;
-        odo_msg_wheel_counts_t wc;
+        odo_msg_wheel_counts_t wc = {0};
         (void)odo_can_unpack_wheel_counts(f, &truck, &wc);
         odo_wheel_input_t *w = &in->wheel[truck];
         stale = w->present && !newer(w->seq, wc.seq);

@@ -148,11 +148,44 @@ int64_t odo_scrub_dturn(const odo_model_t *m, int32_t d_left, int32_t d_right);
 /// midpoint or the paper's heading form. Shared by odometry and IPEC re-integration.
 void odo_pose_advance(odo_pose_t *p, int64_t dist_mm_q40, int64_t dturn_q64, uint8_t heading_form);
 
-/// Conversions for output: heading as BAM (rounded), position in units of 10 um (rounded,
-/// saturating to int32: +-21.47 km, the POSE_XY frame's range; *saturated, if not NULL, is set
+/// sin(x) / x in Q30 for x = dturn_q64 / 2 (signed turns Q64, below half a turn): 1 - x^2/6 +
+/// x^4/120 - x^6/5040, within 3e-5 up to |x| = pi/2. Multiplies only. The chord factor of a step
+/// over several ticks (odo_truck_step); not on the per-tick path.
+int32_t odo_sinc_half_q30(int64_t dturn_q64);
+
+/// What odo_truck_tick did, as bits of its result (the same meaning as odo_step_t's fields).
+#define ODO_STEP_JUMP  0x1U ///< implausible or ambiguous reading: nothing integrated, baseline re-taken
+#define ODO_STEP_RANGE 0x2U ///< the pose is beyond ODO_POSE_LIMIT_MM_Q32
+
+/// odo_truck_step in the form the 40 ms step uses (odo_app.c): the sample as the tick input has it
+/// (w->present is not looked at), the result as ODO_STEP_* bits, the displacement U (mm Q40) and
+/// heading change (signed turns Q64) written to motion[0] and motion[1] (0 when nothing was
+/// integrated). The same body as odo_truck_step, bit for bit, without the result struct to fill
+/// and copy. Constant time.
+uint32_t odo_truck_tick(odo_truck_t *t, const odo_model_t *m, const odo_wheel_input_t *w, uint32_t ticks,
+                        int64_t motion[2]);
+
+/// Conversions for output: heading as BAM (rounded), position in units of 10 um (rounded half
+/// up, saturating to int32: +-21.47 km, the POSE_XY frame's range; *saturated, if not NULL, is set
 /// true when it saturated and left alone otherwise).
 uint32_t odo_heading_bam(const odo_pose_t *p);
 int32_t odo_mm_q32_to_10um(int64_t v_mm_q32, bool *saturated);
+
+/// mm Q32 to units of 10 um, rounded half up, not saturated: floor(v * 100 / 2^32 + 1/2), exact
+/// for every int64 (the result is below 2^38 in magnitude). With v = hi 2^32 + lo: hi * 100 plus
+/// floor((lo * 100 + 2^31) / 2^32), the latter from lo's two 16-bit halves in 32-bit arithmetic
+/// (two MULs; a 64-bit product by the constant 100 is expanded by gcc into a dozen shifts and
+/// adds). About 11 instructions. The step saturates the result itself (odo_app.c);
+/// odo_mm_q32_to_10um above is the same plus the clamp.
+static inline int64_t odo_mm_q32_to_10um_wide(int64_t v_mm_q32)
+{
+    const uint32_t lo = (uint32_t)((uint64_t)v_mm_q32 & 0xFFFFFFFFU);
+    const uint32_t hi = (uint32_t)((uint64_t)v_mm_q32 >> 32);
+    const int32_t shi = hi <= (uint32_t)INT32_MAX ? (int32_t)hi : -(int32_t)(~hi) - 1;
+    /* lo * 100 = a 2^16 + b with a, b < 2^23; floor((a 2^16 + b + 2^31) / 2^32) nests exactly. */
+    const uint32_t a = (lo >> 16) * 100U, b = (lo & 0xFFFFU) * 100U;
+    return (int64_t)shi * 100 + (int64_t)((a + ((b + 0x80000000U) >> 16)) >> 16);
+}
 
 #ifdef __cplusplus
 }

@@ -100,19 +100,33 @@ def make_ticks(args: argparse.Namespace, work: Path) -> dict[str, Path]:
     return out
 
 
-def emulate(elf: Path, block: bytes, ticks: list[tuple[bytes, bytes]], limit: int | None):
-    fw = Firmware(elf, ["odo_app_init", "odo_app_step"])
+def emulate(elf: Path, block: bytes, ticks: list[tuple[bytes, bytes]], limit: int | None,
+            profile: dict | None = None):
+    """Init and every tick; returns (init count, per-tick counts, ticks whose output differs).
+    With profile (a dict), also fills it with each function's own instructions per tick: the
+    mean over the run ("mean") and the worst tick's ("worst")."""
+    fw = Firmware(elf, ["odo_app_init", "odo_app_step"], profile=profile is not None)
     fw.write("odo_bench_block", block)
     status, init = fw.call("odo_bench_init", len(block))
     if status != 0:
         raise SystemExit(f"odo-bench-target: the M4 rejected the parameter block ({status})")
     counts, differ = [], []
+    tally = fw.counter.by_function
+    if tally is not None:
+        tally.clear()
+    worst: dict[str, int] = {}
     for i, (tin, want) in enumerate(ticks[:limit]):
         fw.write("odo_bench_in", tin)
+        before = tally.copy() if tally is not None else None
         _, n = fw.call("odo_bench_step")
+        if tally is not None and (not counts or n > max(counts)):
+            worst = dict((tally - before).most_common())
         counts.append(n)
         if fw.read("odo_bench_out") != want:
             differ.append(i)
+    if profile is not None and tally is not None and counts:
+        profile["mean"] = {k: round(v / len(counts), 1) for k, v in tally.most_common()}
+        profile["worst"] = worst
     return init, counts, differ
 
 
@@ -197,6 +211,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--ticks", type=int, default=None, help="only the first N ticks of each run")
     ap.add_argument("--qemu-cross-check", type=int, metavar="N", default=None,
                     help="compare unicorn's counts with qemu's execution log over N ticks")
+    ap.add_argument("--profile", action="store_true",
+                    help="also each function's own instructions per tick (mean, and in the worst "
+                    "tick) as cm4_profile_<mode>: where a budget goes")
     ap.add_argument("--json", action="store_true", help="JSON only (the default prints it too)")
     args = ap.parse_args(argv)
     for p in (args.cm4_dir / "bin/odo_bench_cm4.elf", args.cm4_dir / "bin/odo_image.elf"):
@@ -215,7 +232,10 @@ def main(argv: list[str] | None = None) -> int:
         for mode in MODES:
             t0 = time.monotonic()
             block, ticks = read_ticks(files[mode], record_sizes(elf))
-            init, counts, differ = emulate(elf, block, ticks, args.ticks)
+            prof: dict | None = {} if args.profile else None
+            init, counts, differ = emulate(elf, block, ticks, args.ticks, prof)
+            if prof is not None:
+                res[f"cm4_profile_{mode}"] = prof
             log(f"IPEC {mode}: {len(counts)} ticks in {time.monotonic() - t0:.1f} s, "
                 f"{len(differ)} outputs differ from the host's")
             res[f"cm4_instr_tick_{mode}_mean"] = round(sum(counts) / len(counts), 1)

@@ -9,6 +9,8 @@ reaches the return address it was called with (LR at entry), calls inside includ
 
 from __future__ import annotations
 
+import bisect
+from collections import Counter as Tally
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -48,12 +50,14 @@ class Counter:
     ret: int = 0
     count: int = 0
     cache: dict[tuple[int, int], int] = field(default_factory=dict)
+    # With profiling on: instructions per function (self, by the address of each block).
+    by_function: Tally[str] | None = None
 
 
 class Firmware:
     """An ELF loaded into a fresh emulated Cortex-M4."""
 
-    def __init__(self, elf: Path, measured: list[str]) -> None:
+    def __init__(self, elf: Path, measured: list[str], profile: bool = False) -> None:
         with open(elf, "rb") as f:
             e = ELFFile(f)
             self.symbols: dict[str, tuple[int, int]] = {}
@@ -72,6 +76,11 @@ class Firmware:
         # `bx lr` back to the trap address ends a call: a 16-bit `b .` there keeps it harmless.
         self.uc.mem_write(RETURN_TRAP, b"\xfe\xe7")
         self.counter = Counter({self.addr(n) & ~1: n for n in measured})
+        if profile:
+            self.counter.by_function = Tally()
+        funcs = sorted((a & ~1, n) for n, (a, size) in self.symbols.items() if size > 0)
+        self._func_starts = [a for a, _ in funcs]
+        self._func_names = [n for _, n in funcs]
         self.uc.hook_add(UC_HOOK_BLOCK, self._on_block)
 
     def addr(self, name: str) -> int:
@@ -95,6 +104,13 @@ class Firmware:
         if n is None:
             n = c.cache[key] = thumb_instructions(bytes(uc.mem_read(address, size)))
         c.count += n
+        if c.by_function is not None:
+            c.by_function[self.function_at(address)] += n
+
+    def function_at(self, address: int) -> str:
+        """The symbol whose code holds address (the nearest function start at or below it)."""
+        i = bisect.bisect_right(self._func_starts, address) - 1
+        return self._func_names[i] if i >= 0 else "?"
 
     def call(self, name: str, *args: int) -> tuple[int, int]:
         """Call a function; returns (r0, instructions counted in measured functions)."""

@@ -207,8 +207,10 @@ def flash_by_origin(map_file: Path, flash_lo: int, flash_hi: int) -> dict[str, i
 
 
 def classify(obj: str) -> str:
-    if "libodo_firmware" in obj:
-        return "firmware"
+    if "libodo_core" in obj:
+        return "core"  # firmware/src: the portable core
+    if "libodo_app" in obj:
+        return "app"  # firmware/app: the 40 ms step and the loop
     if "libgcc" in obj:
         return "libgcc"
     if "libc" in obj or "libg_nano" in obj or "libnosys" in obj:
