@@ -44,11 +44,24 @@ def estimate(prs: list[Prepared], trucks: int) -> tuple[Instrument, list[str]]:
     """(instrument, notes for the report) from the runs that have a truth track. The latency
     and the lever arm are estimated in turn, twice: each blurs the other (the independent
     world's 25 mm marker left its 27 ms latency within the 10 % a shift must gain)."""
-    inst = Instrument(lever_mm=[(0.0, 0.0)] * trucks, lever_se_mm=[(0.0, 0.0)] * trucks)
+    inst = Instrument(
+        lever_mm=[(0.0, 0.0)] * trucks,
+        lever_se_mm=[(0.0, 0.0)] * trucks,
+        heading_offset_rad=[0.0] * trucks,
+    )
     with_truth = [pr for pr in prs if pr.run.truth is not None]
+    for t in range(trucks):
+        o, se, n = heading_offset(with_truth, t)
+        if o is not None and abs(o) >= HEADING_OFFSET_SIGNIFICANT * se:
+            inst.heading_offset_rad[t] = o
     for _ in range(2):
         notes = []
-        found = {pr.run.name: latency(pr, lever=inst.lever_mm[0]) for pr in with_truth}
+        found = {
+            pr.run.name: latency(
+                pr, lever=inst.lever_mm[0], heading_offset=inst.heading_offset_rad[0]
+            )
+            for pr in with_truth
+        }
         inst.latency_s.update(session_latencies(with_truth, found))
         for t in range(trucks):
             o, se, n = lever_arm(with_truth, t, inst)
@@ -63,15 +76,71 @@ def estimate(prs: list[Prepared], trucks: int) -> tuple[Instrument, list[str]]:
     return inst, notes
 
 
+HEADING_OFFSET_SIGNIFICANT = 3.0  # |offset| in standard errors below which it is left at zero
+STRAIGHT_RAD = 0.01  # a window turning less than this (truth) ...
+STRAIGHT_MIN_MM = 20.0  # ... and moving at least this far is a straight for the heading offset
+
+
+def heading_offset(prs: list[Prepared], truck: int) -> tuple[float | None, float, int]:
+    """The marker body's heading against the truck's, from the truth alone: on a straight (or
+    any stretch of constant curvature) the truck moves along the mean of its start and end
+    headings, so the chord of each 0.4 s window that turns less than STRAIGHT_RAD, against the
+    measured headings' mean, is the offset (reversing: the chord turned by pi). A lever arm does
+    not move a chord while the heading holds. (offset rad, its standard error, windows); None
+    with fewer than LEVER_MIN_WINDOWS windows. The independent world's rig heading offset of up to
+    0.3 deg, left in, turned every window's increment off the body axes (a 1.4 mm lateral
+    misfit per window on the LabMate's squares) and rotated the anchored model track, 20 mm
+    over a leg: the fits took it for skid or a scrub and made held-out runs worse."""
+    vals, wts = [], []
+    for pr in prs:
+        tr = pr.run.truth
+        if truck >= tr.pose.shape[1]:
+            continue
+        i, j = _windows(tr.t_s)
+        p = tr.pose[:, truck]
+        dx, dy = p[j, 0] - p[i, 0], p[j, 1] - p[i, 1]
+        d = np.hypot(dx, dy)
+        dth = p[j, 2] - p[i, 2]
+        ok = (np.abs(dth) < STRAIGHT_RAD) & (d >= STRAIGHT_MIN_MM)
+        if not ok.any():
+            continue
+        hm = p[i, 2] + 0.5 * dth
+        chord = np.arctan2(dy, dx)
+        o = np.angle(np.exp(1j * (hm - chord)))
+        o = np.where(np.abs(o) > 0.5 * math.pi, np.angle(np.exp(1j * (o - math.pi))), o)  # reverse
+        vals.append(o[ok])
+        wts.append(d[ok])
+    if not vals:
+        return None, 0.0, 0
+    o, w = np.concatenate(vals), np.concatenate(wts)
+    if o.size < LEVER_MIN_WINDOWS:
+        return None, 0.0, int(o.size)
+    med = float(np.median(o))
+    s = max(_mad(o), 1e-9)
+    keep = np.abs(o - med) <= 4.0 * s  # a bump's jolt, a skid's slide: not the rig
+    o, w = o[keep], w[keep]
+    m = float(np.average(o, weights=w))
+    se = float(math.sqrt(np.average((o - m) ** 2, weights=w) / max(o.size - 1, 1)))
+    return m, se, int(o.size)
+
+
 def under(inst: Instrument, prs: list[Prepared], P: dict) -> Instrument:
     """The instrument with each run's latency estimated again under a candidate P, without the
     half-tick floor: once the candidate takes its own share of the heading misfit where the rate
     changes (slip does; a kinematic effect does not), what is left of a shift is the clock. The
     OptiOdom squares' ~25 ms, half their 50 ms tick, read as the truth's noise otherwise."""
-    out = Instrument(list(inst.lever_mm), list(inst.lever_se_mm), dict(inst.latency_s))
+    out = inst.copy()
     with_truth = [pr for pr in prs if pr.run.truth is not None]
     found = {
-        pr.run.name: latency(pr, 0, P, min_tick=0.0, lever=inst.lever_mm[0]) for pr in with_truth
+        pr.run.name: latency(
+            pr,
+            0,
+            P,
+            min_tick=0.0,
+            lever=inst.lever_mm[0],
+            heading_offset=inst.heading_offset_rad[0],
+        )
+        for pr in with_truth
     }
     out.latency_s.update(session_latencies(with_truth, found))
     return out
@@ -111,6 +180,7 @@ def latency(
     P: dict | None = None,
     min_tick: float = 0.0,
     lever: tuple[float, float] = (0.0, 0.0),
+    heading_offset: float = 0.0,
 ) -> float | None:
     """The shift (s) that best lines the truth's heading (times half the wheelbase) and travel
     increments over 0.4 s windows up with the model's (P, nominal by default); None when no
@@ -124,7 +194,7 @@ def latency(
     i, j = _windows(tt)
     if i.size < 10:
         return None
-    tp = to_centre(tr.pose[:, truck : truck + 1], [lever])[:, 0]
+    tp = to_centre(tr.pose[:, truck : truck + 1], [lever], [heading_offset])[:, 0]
     half_b = 0.5 * pr.b[truck]
     dth = tp[j, 2] - tp[i, 2]
     c, s_ = np.cos(tp[i, 2]), np.sin(tp[i, 2])
@@ -223,7 +293,8 @@ def lever_arm(
             continue
         p = dead_reckon(pr, P or {}, truck)
         m = np.column_stack([np.interp(tt, pr.t, p[:, k]) for k in range(3)])
-        inc_t = _body_inc(tr.pose[:, truck], i, j)
+        off = inst.heading_offset_rad[truck] if truck < len(inst.heading_offset_rad) else 0.0
+        inc_t = _body_inc(to_centre(tr.pose[:, truck : truck + 1], [(0.0, 0.0)], [off])[:, 0], i, j)
         inc_m = _body_inc(m, i, j)
         dth = inc_t[:, 2]
         travel = np.hypot(inc_m[:, 0], inc_m[:, 1])
