@@ -77,50 +77,88 @@ def estimate(prs: list[Prepared], trucks: int) -> tuple[Instrument, list[str]]:
 
 
 HEADING_OFFSET_SIGNIFICANT = 3.0  # |offset| in standard errors below which it is left at zero
-STRAIGHT_RAD = 0.01  # a window turning less than this (truth) ...
-STRAIGHT_MIN_MM = 20.0  # ... and moving at least this far is a straight for the heading offset
+STRAIGHT_RAD = 0.01  # a stretch whose heading stays within this band (counts, nominal) ...
+STRAIGHT_MIN_MM = 100.0  # ... over at least this much travel is a straight (heading offset)
+STRAIGHT_EDGE_S = 0.1  # trimmed off a straight's ends
+HEADING_MIN_STRAIGHTS = 4
+
+
+def _straights(pr: Prepared, truck: int) -> list[tuple[float, float]]:
+    """(t0, t1) of the stretches the wheel counts say are straight: both wheels rolling one way,
+    the nominal heading staying within a band of STRAIGHT_RAD (a controller weaves about a
+    straight: the chord still follows the mean heading), at least STRAIGHT_MIN_MM long;
+    STRAIGHT_EDGE_S trimmed off both ends (the truth's latency)."""
+    ds = pr.ds[:, truck, :]
+    b = pr.b[truck]
+    dth = (ds[:, 1] - ds[:, 0]) / b
+    step = 0.5 * (ds[:, 0] + ds[:, 1])
+    ok = ds[:, 0] * ds[:, 1] > 0
+    out = []
+    k = 0
+    n = ok.size
+    while k < n:
+        if not ok[k]:
+            k += 1
+            continue
+        e = k
+        th, lo, hi, L = 0.0, 0.0, 0.0, 0.0
+        while e < n and ok[e] and np.sign(step[e]) == np.sign(step[k]):
+            th += dth[e]
+            lo, hi = min(lo, th), max(hi, th)
+            if hi - lo > STRAIGHT_RAD:
+                break
+            L += abs(step[e])
+            e += 1
+        t0, t1 = pr.t[k] + STRAIGHT_EDGE_S, pr.t[e] - STRAIGHT_EDGE_S
+        if L >= STRAIGHT_MIN_MM and t1 > t0:
+            out.append((float(t0), float(t1)))
+        k = max(e, k + 1)
+    return out
 
 
 def heading_offset(prs: list[Prepared], truck: int) -> tuple[float | None, float, int]:
-    """The marker body's heading against the truck's, from the truth alone: on a straight (or
-    any stretch of constant curvature) the truck moves along the mean of its start and end
-    headings, so the chord of each 0.4 s window that turns less than STRAIGHT_RAD, against the
-    measured headings' mean, is the offset (reversing: the chord turned by pi). A lever arm does
-    not move a chord while the heading holds. (offset rad, its standard error, windows); None
-    with fewer than LEVER_MIN_WINDOWS windows. The independent world's rig heading offset of up to
-    0.3 deg, left in, turned every window's increment off the body axes (a 1.4 mm lateral
-    misfit per window on the LabMate's squares) and rotated the anchored model track, 20 mm
-    over a leg: the fits took it for skid or a scrub and made held-out runs worse."""
-    vals, wts = [], []
+    """The marker body's heading against the truck's, from the truth's chords: on a straight the
+    truck moves along its heading, so over each stretch the wheel counts say is straight
+    (`_straights`: the counts are precise where a noisy truth heading is not) the mean of the
+    measured headings less the chord's direction is the offset (reversing: the chord turned by
+    pi). A lever arm does not move a chord while the heading holds, and a latency moves
+    neither. (offset rad, its standard error, stretches); None with fewer than
+    HEADING_MIN_STRAIGHTS stretches. The independent world's rig heading offset of up to 0.3 deg,
+    left in, turned every window's increment off the body axes (a 1.4 mm lateral misfit per
+    window on a LabMate's squares) and rotated the anchored model track, 20 mm over a leg: the
+    fits took it for skid or scrub and made held-out runs worse."""
+    vals, var = [], []
     for pr in prs:
         tr = pr.run.truth
         if truck >= tr.pose.shape[1]:
             continue
-        i, j = _windows(tr.t_s)
         p = tr.pose[:, truck]
-        dx, dy = p[j, 0] - p[i, 0], p[j, 1] - p[i, 1]
-        d = np.hypot(dx, dy)
-        dth = p[j, 2] - p[i, 2]
-        ok = (np.abs(dth) < STRAIGHT_RAD) & (d >= STRAIGHT_MIN_MM)
-        if not ok.any():
-            continue
-        hm = p[i, 2] + 0.5 * dth
-        chord = np.arctan2(dy, dx)
-        o = np.angle(np.exp(1j * (hm - chord)))
-        o = np.where(np.abs(o) > 0.5 * math.pi, np.angle(np.exp(1j * (o - math.pi))), o)  # reverse
-        vals.append(o[ok])
-        wts.append(d[ok])
-    if not vals:
-        return None, 0.0, 0
-    o, w = np.concatenate(vals), np.concatenate(wts)
-    if o.size < LEVER_MIN_WINDOWS:
-        return None, 0.0, int(o.size)
+        th = np.unwrap(p[:, 2])
+        for t0, t1 in _straights(pr, truck):
+            k = np.flatnonzero((tr.t_s >= t0) & (tr.t_s <= t1))
+            if k.size < 3:
+                continue
+            dx, dy = p[k[-1], 0] - p[k[0], 0], p[k[-1], 1] - p[k[0], 1]
+            L = math.hypot(dx, dy)
+            if L < STRAIGHT_MIN_MM:
+                continue
+            o = math.remainder(float(np.mean(th[k])) - math.atan2(dy, dx), 2 * math.pi)
+            if abs(o) > 0.5 * math.pi:  # reversing
+                o = math.remainder(o - math.pi, 2 * math.pi)
+            vals.append(o)
+            var.append((float(np.var(np.diff(th[k]))) / 2.0) / k.size + 1.0 / L**2)
+    if len(vals) < HEADING_MIN_STRAIGHTS:
+        return None, 0.0, len(vals)
+    o, v = np.array(vals), np.array(var)
+    # each stretch's own noise gives a relative weight; the spread about the mean sets the scale
+    # (a controller that weaves along a straight moves the chord too)
+    w = 1.0 / v
     med = float(np.median(o))
-    s = max(_mad(o), 1e-9)
-    keep = np.abs(o - med) <= 4.0 * s  # a bump's jolt, a skid's slide: not the rig
+    keep = np.abs(o - med) <= 4.0 * max(_mad(o), 1e-9)  # a bump's jolt: not the rig
     o, w = o[keep], w[keep]
     m = float(np.average(o, weights=w))
-    se = float(math.sqrt(np.average((o - m) ** 2, weights=w) / max(o.size - 1, 1)))
+    chi = float(np.sum(w * (o - m) ** 2) / max(o.size - 1, 1))
+    se = float(math.sqrt(chi / np.sum(w)))
     return m, se, int(o.size)
 
 
