@@ -41,7 +41,7 @@ from .fit import (
     fit_params,
     returns_spread,
 )
-from .heldout import HeldOut, apply
+from .heldout import HELDOUT_BUMP_MIN_RUNS, HeldOut, apply
 from .heldout import evaluate as evaluate_heldout
 from .io import Robot, RunData, discover_all, read_robot
 from .model import Prepared, prepare
@@ -498,9 +498,12 @@ def judge(ds: Dataset, sel: Selection, rk: Ranking) -> Judgement:
         fit_items = [items[i] for i in sel.fit]
         ds.items = items
     fprs = [ds.prs[i] for i in sel.fit]
+    hprs = [ds.prs[i] for i in sel.held if i not in sel.fit]
+    apply(rk.best, hprs, HELDOUT_BUMP_MIN_RUNS)  # as evaluate_heldout places them
     apply(rk.best, fprs)
-    bg = measure(fit_items, rk.prob.sigma, ds.mode, rk.best.model_params())
-    clear_bumps(fprs)
+    pool = [items[i] for i in sel.held if i not in sel.fit] if ds.mode == "truth" else None
+    bg = measure(fit_items, rk.prob.sigma, ds.mode, rk.best.model_params(), pool=pool)
+    clear_bumps(fprs + hprs)
     held = evaluate_heldout(items, ds.prs, list(sel.held), rk.best, rk.prob.sigma, bg)
     if ds.noise_dof is not None:
         held.extra["noise_dof"] = ds.noise_dof
