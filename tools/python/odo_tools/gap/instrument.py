@@ -77,7 +77,7 @@ def estimate(prs: list[Prepared], trucks: int) -> tuple[Instrument, list[str]]:
 
 
 HEADING_OFFSET_SIGNIFICANT = 3.0  # |offset| in standard errors below which it is left at zero
-STRAIGHT_RAD = 0.01  # a stretch whose heading stays within this band (counts, nominal) ...
+STRAIGHT_RAD = 0.02  # a stretch whose heading stays within this band (counts, nominal) ...
 STRAIGHT_MIN_MM = 100.0  # ... over at least this much travel is a straight (heading offset)
 STRAIGHT_EDGE_S = 0.1  # trimmed off a straight's ends
 HEADING_MIN_STRAIGHTS = 4
