@@ -260,7 +260,8 @@ def rank(ds: Dataset, sel: Selection, progress: Progress = None) -> Ranking:
     sig_head = _sig_head(prob, chans)
     fprs = [ds.prs[i] for i in fit_i]
     if ds.mode == "truth":
-        walk = floor_walk(prob, ds.robot.vehicle)
+        held = [ds.items[i] for i in sel.held if i not in sel.fit]
+        walk = floor_walk(prob, ds.robot.vehicle, held)
         sig = np.array(prob.sigma, dtype=float)
         k = walk.window_sigma.size
         T = 3 * ds.robot.n_trucks
@@ -387,13 +388,14 @@ def _track_ratio(f: Fit, prob: Problem, ds: Dataset, sel: Selection) -> float:
 PRELIM = ("ed.value", "eb.value", "es.value", "scrub.k")
 
 
-def floor_walk(prob: Problem, vehicle: str) -> Background:
+def floor_walk(prob: Problem, vehicle: str, pool: list | None = None) -> Background:
     """The floor's walk (background.measure) under a preliminary fit of the kinematic effects
     (Ed, Eb, Es, scrub: cheap, always well posed), so that their systematic misfit, repeated at
-    every turn, is not taken for a walk."""
+    every turn, is not taken for a walk; `pool`: the held-out runs, for what does not repeat
+    between runs of a path (nothing of theirs is fitted)."""
     keys = [k for k in PRELIM if k.split(".")[0] in catalog.hypotheses(prob.mode, vehicle)]
     P, _ = fit_params(prob, keys)
-    return measure(prob.items, prob.sigma, prob.mode, P)
+    return measure(prob.items, prob.sigma, prob.mode, P, pool=pool)
 
 
 ROUGH_MIN_MM = 0.05  # a roughness fitted below this is no floor at all
