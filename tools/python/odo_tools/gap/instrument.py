@@ -13,9 +13,9 @@ per run). Both move the truth in ways no catalog effect should be asked to expla
   increments up with the nominal model's, kept where it lowers the misfit beyond chance
   (Delta chi^2 25); a run that does not fix it (a spin) takes its session's median. A session
   whose runs disagree (their 10-90 % range beyond a third of their median or a quarter tick)
-  keeps only latencies of 1.5 ticks or more: slip on a turn's start mimics a latency that
-  varies with how hard each path accelerates (the simulator's slip read 12 ms on UMBmark and
-  25 ms on rect-7x4); a clock offset is the same on every run (the independent world's 22-25 ms).
+  keeps only latencies of 1.5 ticks or more: slip on a turn's start mimics a latency that varies with how hard each path
+  accelerates (the simulator's slip read 12 ms on UMBmark and 25 ms on rect-7x4); a clock
+  offset is the same on every run (the independent world's 22-25 ms).
 
 The OptiOdom circles carry ~0.1-0.3 s of latency between mocap and wheel counts (their heading
 misfit follows the turn rate), the squares ~25 ms; the lever arm of its marker is ~1-2 cm.
