@@ -12,8 +12,8 @@ per run). Both move the truth in ways no catalog effect should be asked to expla
 - **Latency** (per run): the time shift that best lines the truth's heading and travel
   increments up with the nominal model's, kept where it lowers the misfit beyond chance
   (Delta chi^2 25); a run that does not fix it (a spin) takes its session's median. A session
-  whose runs disagree (their 10-90 % range beyond a third of their median or a quarter tick)
-  keeps only latencies of 1.5 ticks or more: slip on a turn's start mimics a latency that varies with how hard each path
+  whose runs disagree (beyond a third of their median or a quarter tick) keeps only latencies of
+  1.5 ticks or more: slip on a turn's start mimics a latency that varies with how hard each path
   accelerates (the simulator's slip read 12 ms on UMBmark and 25 ms on rect-7x4); a clock
   offset is the same on every run (the independent world's 22-25 ms).
 
