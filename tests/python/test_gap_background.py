@@ -236,24 +236,3 @@ def test_walk_of_single_run_paths_is_measured_against_the_held_out_runs(tmp_path
     pooled = measure(fit, sigma, "truth", {}, pool=held)
     assert alone.q_wheel[0] > 1e-4
     assert pooled.q_wheel[0] < 0.01 * alone.q_wheel[0], (alone.q_wheel, pooled.q_wheel)
-
-
-def test_one_clock_is_not_broken_by_one_noisy_run() -> None:
-    """A clock offset read per run scatters by a few ms: the independent world's clapper (16 ms
-    on 20 ms ticks) read 14-21 ms, the whole range beyond a third of the median, and every
-    latency was dropped (a no-effect robot came out "unexplained", R 5.3). Latencies that
-    follow the path, as slip mimics them (12 ms on the squares, 25 ms on the rectangles), are
-    still no clock."""
-    from types import SimpleNamespace
-
-    from odo_tools.gap.instrument import one_clock
-
-    def runs(lat_ms):
-        prs = [
-            SimpleNamespace(run=SimpleNamespace(name=f"r{k}", session="s"), dt=np.full(5, 0.02))
-            for k in range(len(lat_ms))
-        ]
-        return prs, {f"r{k}": x / 1000.0 for k, x in enumerate(lat_ms)}
-
-    assert one_clock(*runs([14.4, 16.2, 16.2, 16.4, 17.0, 17.8, 20.6]))["s"]
-    assert not one_clock(*runs([12.0] * 6 + [25.0] * 4))["s"]
