@@ -130,13 +130,18 @@ def latency(
     c, s_ = np.cos(tp[i, 2]), np.sin(tp[i, 2])
     dlong = c * (tp[j, 0] - tp[i, 0]) + s_ * (tp[j, 1] - tp[i, 1])
 
+    # the model is needed at the windows' ends only (np.interp is pointwise: same numbers)
+    ends = np.union1d(i, j)
+    ie, je = np.searchsorted(ends, i), np.searchsorted(ends, j)
+    t_ends = tt[ends]
+
     def resid(L: float) -> np.ndarray:
-        tm = tt - L
-        ok = (tm[i] >= pr.t[0]) & (tm[j] <= pr.t[-1])
+        tm = t_ends - L
+        ok = (tm[ie] >= pr.t[0]) & (tm[je] <= pr.t[-1])
         m = np.column_stack([np.interp(tm, pr.t, p[:, k]) for k in range(3)])
-        cm, sm = np.cos(m[i, 2]), np.sin(m[i, 2])
-        ml = cm * (m[j, 0] - m[i, 0]) + sm * (m[j, 1] - m[i, 1])
-        r = np.concatenate([(dth - (m[j, 2] - m[i, 2])) * half_b, dlong - ml])
+        cm, sm = np.cos(m[ie, 2]), np.sin(m[ie, 2])
+        ml = cm * (m[je, 0] - m[ie, 0]) + sm * (m[je, 1] - m[ie, 1])
+        r = np.concatenate([(dth - (m[je, 2] - m[ie, 2])) * half_b, dlong - ml])
         return np.where(np.concatenate([ok, ok]), r, np.nan)
 
     grid = np.arange(-LATENCY_MAX_S, LATENCY_MAX_S + 1e-9, LATENCY_STEP_S)
