@@ -273,7 +273,7 @@ def slip_traction(pr: Prepared, ds: np.ndarray, a_max: float) -> np.ndarray:
     lim = a_max * 1e3 * pr.dt  # mm/s per tick
     u = np.empty_like(v)
     # a rate limiter is sequential: a loop over Python floats (the same IEEE operations as the
-    # per-tick numpy clip it replaces, ~15x faster: a fit calls it once per step and Jacobian column)
+    # per-tick numpy clip it replaced, 15x faster; a fit calls it for every step and column)
     lims = lim.tolist()
     for w in (0, 1):
         cur = 0.0
