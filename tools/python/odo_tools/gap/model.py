@@ -481,12 +481,20 @@ def _track(pr: Prepared, P: dict, truck: int) -> np.ndarray:
         tuple(sorted((k, v) for k, v in truck_view(P, truck).items() if not k.startswith(skip))),
         tuple((b["truck"], b["wheel"], b["s0"], b["h"]) for b in pr.bumps),
     )
-    hit = pr.track_cache.get(key)
+    cache = pr.track_cache
+    hit = cache.pop(key, None)
     if hit is None:
-        if len(pr.track_cache) > 8:
-            pr.track_cache.clear()
-        hit = pr.track_cache[key] = integrate(*floor_travel(pr, P, truck))
+        if len(cache) >= TRACK_CACHE:  # least recently used out (a dict keeps insertion order)
+            del cache[next(iter(cache))]
+        hit = integrate(*floor_travel(pr, P, truck))
+    cache[key] = hit  # (re)inserted last: most recently used
     return hit
+
+
+# tracks kept per run: a fit's current point, its Jacobian's columns and the nominal model, which
+# the background, the phases and the held-out runs ask for again and again (clearing all of them
+# at 9 entries, as before, recomputed one track in six; ~75 kB per track of 3000 ticks)
+TRACK_CACHE = 24
 
 
 def dead_reckon(pr: Prepared, P: dict, truck: int = 0, pose0=(0.0, 0.0, 0.0)) -> np.ndarray:
