@@ -4,7 +4,7 @@ SHELL := /bin/bash
 .DEFAULT_GOAL := help
 JOBS ?= $(shell nproc)
 
-.PHONY: help deps build release cm4 test demo bench bench-target soak fuzz coverage format flash flash-params flash-all package lock clean
+.PHONY: help deps build release cm4 test demo bench bench-target bench-gap soak fuzz coverage format flash flash-params flash-all package lock clean
 
 help: ## list targets
 	@grep -E '^[a-z0-9-]+:.*## ' $(MAKEFILE_LIST) | awk -F':.*## ' '{printf "  make %-12s %s\n", $$1, $$2}'
@@ -35,6 +35,9 @@ bench: release ## print benchmark figures as JSON (-O2 build: build/release/bin/
 
 bench-target: release cm4 ## Cortex-M4 figures as JSON: instructions per tick (emulated), flash, RAM, stack
 	@.venv/bin/odo-bench-target --build-dir build/release --cm4-dir build/cm4
+
+bench-gap: build ## odo-gap diagnosis time on dev cases as JSON; REF=<git rev> adds the ratio against it
+	@.venv/bin/python -m odo_tools.gap.bench $(if $(REF),--ref $(REF))
 
 flash: cm4 ## program the image with openocd, never its parameter sector (odo-flash code)
 	@.venv/bin/odo-flash code --image build/cm4/bin/odo_image.elf

@@ -5,12 +5,12 @@
 ///    files go before their folders.
 ///  - Identity checks use (st_dev, st_ino), which sees through symlinks, bind mounts and "..".
 #include "odo_out.h"
+#include "odo_err.h"
 
 #include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
 #include <signal.h>
-#include <stdarg.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
@@ -130,18 +130,6 @@ static void reg_drop(reg_node_t *n)
  * Small helpers
  * ------------------------------------------------------------------------------------------- */
 
-static int fail(char *err, size_t errlen, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
-static int fail(char *err, size_t errlen, const char *fmt, ...)
-{
-    if (err != NULL && errlen > 0U) {
-        va_list ap;
-        va_start(ap, fmt);
-        (void)vsnprintf(err, errlen, fmt, ap);
-        va_end(ap);
-    }
-    return -1;
-}
-
 static const char *kind_of(mode_t m)
 {
     return S_ISREG(m)    ? "a file"
@@ -232,7 +220,7 @@ static int make_parents(const char *dir, parents_t *made, char *err, size_t errl
     char p[PATH_MAX];
     const size_t len = strlen(dir);
     if (len >= sizeof p) {
-        return fail(err, errlen, "%s: path too long", dir);
+        return odo_errf(err, errlen, "%s: path too long", dir);
     }
     memcpy(p, dir, len + 1U);
     for (size_t i = 1; i <= len; ++i) {
@@ -244,20 +232,20 @@ static int make_parents(const char *dir, parents_t *made, char *err, size_t errl
         struct stat sb;
         if (stat(p, &sb) != 0) {
             if (errno != ENOENT) {
-                return fail(err, errlen, "%s: %s", p, strerror(errno));
+                return odo_errf(err, errlen, "%s: %s", p, strerror(errno));
             }
             reg_node_t *n = (made->n < sizeof made->node / sizeof made->node[0]) ? reg_add(p, 1) : NULL;
             if (n == NULL) {
-                return fail(err, errlen, "%s: too many folders to create", dir);
+                return odo_errf(err, errlen, "%s: too many folders to create", dir);
             }
             if (mkdir(p, 0777) != 0) {
                 const int e = errno;
                 reg_drop(n);
-                return fail(err, errlen, "cannot create folder %s: %s", p, strerror(e));
+                return odo_errf(err, errlen, "cannot create folder %s: %s", p, strerror(e));
             }
             made->node[made->n++] = n;
         } else if (!S_ISDIR(sb.st_mode)) {
-            return fail(err, errlen, "%s is not a folder", p);
+            return odo_errf(err, errlen, "%s is not a folder", p);
         }
         p[i] = keep;
     }
@@ -314,7 +302,7 @@ int odo_out_inputs_add(odo_out_inputs_t *ins, const char *path, char *err, size_
         return 0;
     }
     if (ins->n >= sizeof ins->in / sizeof ins->in[0]) {
-        return fail(err, errlen, "too many inputs");
+        return odo_errf(err, errlen, "too many inputs");
     }
     ins->in[ins->n].dev = sb.st_dev;
     ins->in[ins->n].ino = sb.st_ino;
@@ -342,12 +330,12 @@ int odo_out_check_inputs(const odo_out_inputs_t *ins, const char *path, char *er
     struct stat sb;
     const char *hit;
     if (stat(path, &sb) == 0 && (hit = input_match(ins, &sb, false)) != NULL) {
-        return fail(err, errlen, "%s: the output is also an input (%s); refusing to overwrite it", path, hit);
+        return odo_errf(err, errlen, "%s: the output is also an input (%s); refusing to overwrite it", path, hit);
     }
     /* Every existing ancestor, by identity: "a/../b", symlinked folders and bind mounts included. */
     char p[PATH_MAX];
     if (snprintf(p, sizeof p, "%s", path) >= (int)sizeof p) {
-        return fail(err, errlen, "%s: path too long", path);
+        return odo_errf(err, errlen, "%s: path too long", path);
     }
     for (;;) {
         char dir[PATH_MAX], base[PATH_MAX];
@@ -355,8 +343,8 @@ int odo_out_check_inputs(const odo_out_inputs_t *ins, const char *path, char *er
             break;
         }
         if (stat(dir, &sb) == 0 && (hit = input_match(ins, &sb, true)) != NULL) {
-            return fail(err, errlen, "%s: the output lies inside the input folder %s; refusing to write there", path,
-                        hit);
+            return odo_errf(err, errlen, "%s: the output lies inside the input folder %s; refusing to write there",
+                            path, hit);
         }
         if (strcmp(dir, ".") == 0 || strcmp(dir, "/") == 0) {
             break;
@@ -369,8 +357,9 @@ int odo_out_check_inputs(const odo_out_inputs_t *ins, const char *path, char *er
         if (getcwd(cwd, sizeof cwd) != NULL) {
             for (;;) {
                 if (stat(cwd, &sb) == 0 && (hit = input_match(ins, &sb, true)) != NULL) {
-                    return fail(err, errlen, "%s: the output lies inside the input folder %s; refusing to write there",
-                                path, hit);
+                    return odo_errf(err, errlen,
+                                    "%s: the output lies inside the input folder %s; refusing to write there", path,
+                                    hit);
                 }
                 char *slash = strrchr(cwd, '/');
                 if (slash == NULL || slash == cwd) {
@@ -393,11 +382,11 @@ static int open_temp(const char *dir, const char *base, char *tmp, reg_node_t **
     for (int attempt = 0; attempt < 100; ++attempt) {
         const int w = snprintf(tmp, PATH_MAX, "%s/.%s.tmp-%ld-%06lx", dir, base, (long)getpid(), next_suffix());
         if (w < 0 || w >= PATH_MAX) {
-            return fail(err, errlen, "%s/%s: path too long", dir, base);
+            return odo_errf(err, errlen, "%s/%s: path too long", dir, base);
         }
         reg_node_t *n = reg_add(tmp, 0);
         if (n == NULL) {
-            return fail(err, errlen, "out of memory");
+            return odo_errf(err, errlen, "out of memory");
         }
         const int fd = open(tmp, O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0666);
         if (fd >= 0) {
@@ -407,10 +396,10 @@ static int open_temp(const char *dir, const char *base, char *tmp, reg_node_t **
         const int e = errno;
         reg_drop(n); /* not ours: never unlink what another process (or a planted link) holds */
         if (e != EEXIST) {
-            return fail(err, errlen, "cannot create a temp file in %s: %s", dir, strerror(e));
+            return odo_errf(err, errlen, "cannot create a temp file in %s: %s", dir, strerror(e));
         }
     }
-    return fail(err, errlen, "cannot create a temp file in %s: every name taken", dir);
+    return odo_errf(err, errlen, "cannot create a temp file in %s: every name taken", dir);
 }
 
 /// The target may be absent or a regular file (not through a symlink).
@@ -419,10 +408,10 @@ static int check_file_target(const char *path, char *err, size_t errlen)
     struct stat sb;
     if (lstat(path, &sb) != 0) {
         /* ENOTDIR: an ancestor is not a folder; make_parents names it. */
-        return (errno == ENOENT || errno == ENOTDIR) ? 0 : fail(err, errlen, "%s: %s", path, strerror(errno));
+        return (errno == ENOENT || errno == ENOTDIR) ? 0 : odo_errf(err, errlen, "%s: %s", path, strerror(errno));
     }
     if (!S_ISREG(sb.st_mode)) {
-        return fail(err, errlen, "%s is %s, not a regular file; refusing to replace it", path, kind_of(sb.st_mode));
+        return odo_errf(err, errlen, "%s is %s, not a regular file; refusing to replace it", path, kind_of(sb.st_mode));
     }
     return 0;
 }
@@ -432,7 +421,7 @@ int odo_out_file_begin(odo_out_file_t *o, const char *path, const odo_out_inputs
     memset(o, 0, sizeof *o);
     char dir[PATH_MAX], base[PATH_MAX];
     if (path == NULL || split(path, dir, base) != 0) {
-        return fail(err, errlen, "'%s' is not a file name", path != NULL ? path : "");
+        return odo_errf(err, errlen, "'%s' is not a file name", path != NULL ? path : "");
     }
     if (check_file_target(path, err, errlen) != 0 || odo_out_check_inputs(ins, path, err, errlen) != 0) {
         return -1;
@@ -440,7 +429,7 @@ int odo_out_file_begin(odo_out_file_t *o, const char *path, const odo_out_inputs
     (void)snprintf(o->path, sizeof o->path, "%s", path);
     parents_t *made = calloc(1, sizeof *made);
     if (made == NULL) {
-        return fail(err, errlen, "out of memory");
+        return odo_errf(err, errlen, "out of memory");
     }
     if (make_parents(dir, made, err, errlen) != 0) {
         parents_undo(made);
@@ -463,7 +452,7 @@ int odo_out_file_begin(odo_out_file_t *o, const char *path, const odo_out_inputs
         parents_undo(made);
         free(made);
         o->tmp[0] = '\0';
-        return fail(err, errlen, "%s: %s", path, strerror(errno));
+        return odo_errf(err, errlen, "%s: %s", path, strerror(errno));
     }
     o->reg = reg;
     o->parents = made;
@@ -491,7 +480,7 @@ int odo_out_file_commit(odo_out_file_t *o, char *err, size_t errlen)
 {
     if (o->f == NULL) {
         odo_out_file_abort(o);
-        return fail(err, errlen, "%s: not open", o->path);
+        return odo_errf(err, errlen, "%s: not open", o->path);
     }
     int bad = fflush(o->f) != 0 || ferror(o->f);
     int e = errno;
@@ -505,7 +494,7 @@ int odo_out_file_commit(odo_out_file_t *o, char *err, size_t errlen)
     }
     o->f = NULL;
     if (bad) {
-        (void)fail(err, errlen, "cannot write %s: %s", o->path, strerror(e));
+        (void)odo_errf(err, errlen, "cannot write %s: %s", o->path, strerror(e));
         odo_out_file_abort(o);
         return -1;
     }
@@ -516,7 +505,7 @@ int odo_out_file_commit(odo_out_file_t *o, char *err, size_t errlen)
     }
     if (rename(o->tmp, o->path) != 0) {
         e = errno;
-        (void)fail(err, errlen, "cannot rename into %s: %s", o->path, strerror(e));
+        (void)odo_errf(err, errlen, "cannot rename into %s: %s", o->path, strerror(e));
         odo_out_file_abort(o);
         return -1;
     }
@@ -542,7 +531,7 @@ int odo_out_write(const char *path, const void *data, size_t len, const odo_out_
     if (len > 0U && fwrite(data, 1, len, o.f) != len) {
         const int e = errno;
         odo_out_file_abort(&o);
-        return fail(err, errlen, "cannot write %s: %s", path, strerror(e));
+        return odo_errf(err, errlen, "cannot write %s: %s", path, strerror(e));
     }
     return odo_out_file_commit(&o, err, errlen);
 }
@@ -611,16 +600,16 @@ static int read_manifest(const char *dir, const char *tool, char ***out, size_t 
 {
     char path[PATH_MAX];
     if (join(path, sizeof path, dir, ODO_OUT_MANIFEST) != 0) {
-        return fail(err, errlen, "%s: path too long", dir);
+        return odo_errf(err, errlen, "%s: path too long", dir);
     }
     const int fd = open(path, O_RDONLY | O_NOFOLLOW | O_CLOEXEC);
     if (fd < 0) {
-        return (errno == ENOENT || errno == ELOOP) ? 0 : fail(err, errlen, "%s: %s", path, strerror(errno));
+        return (errno == ENOENT || errno == ELOOP) ? 0 : odo_errf(err, errlen, "%s: %s", path, strerror(errno));
     }
     FILE *f = fdopen(fd, "r");
     if (f == NULL) {
         (void)close(fd);
-        return fail(err, errlen, "%s: %s", path, strerror(errno));
+        return odo_errf(err, errlen, "%s: %s", path, strerror(errno));
     }
     char line[1100];
     char want[128];
@@ -721,12 +710,12 @@ odo_out_dir_t *odo_out_dir_begin(const char *path, const char *tool, bool force,
 {
     char dir[PATH_MAX], base[PATH_MAX];
     if (path == NULL || split(path, dir, base) != 0) {
-        (void)fail(err, errlen, "'%s' is not a folder name", path != NULL ? path : "");
+        (void)odo_errf(err, errlen, "'%s' is not a folder name", path != NULL ? path : "");
         return NULL;
     }
     odo_out_dir_t *d = calloc(1, sizeof *d);
     if (d == NULL) {
-        (void)fail(err, errlen, "out of memory");
+        (void)odo_errf(err, errlen, "out of memory");
         return NULL;
     }
     (void)snprintf(d->path, sizeof d->path, "%s", path);
@@ -741,13 +730,13 @@ odo_out_dir_t *odo_out_dir_begin(const char *path, const char *tool, bool force,
     struct stat sb;
     if (lstat(path, &sb) == 0) {
         if (!S_ISDIR(sb.st_mode)) {
-            (void)fail(err, errlen, "%s is %s, not a folder; refusing to replace it", path, kind_of(sb.st_mode));
+            (void)odo_errf(err, errlen, "%s is %s, not a folder; refusing to replace it", path, kind_of(sb.st_mode));
             odo_out_dir_abort(d);
             return NULL;
         }
         const int empty = dir_is_empty(path);
         if (empty < 0) {
-            (void)fail(err, errlen, "cannot read folder %s: %s", path, strerror(errno));
+            (void)odo_errf(err, errlen, "cannot read folder %s: %s", path, strerror(errno));
             odo_out_dir_abort(d);
             return NULL;
         }
@@ -764,16 +753,16 @@ odo_out_dir_t *odo_out_dir_begin(const char *path, const char *tool, bool force,
             } else if (force) {
                 d->mode = DIR_FORCE;
             } else {
-                (void)fail(err, errlen,
-                           "%s is a non-empty folder %s did not write (no %s of its own in it); refusing to write "
-                           "there (--force writes into it, replacing same-named files and removing nothing)",
-                           path, tool, ODO_OUT_MANIFEST);
+                (void)odo_errf(err, errlen,
+                               "%s is a non-empty folder %s did not write (no %s of its own in it); refusing to write "
+                               "there (--force writes into it, replacing same-named files and removing nothing)",
+                               path, tool, ODO_OUT_MANIFEST);
                 odo_out_dir_abort(d);
                 return NULL;
             }
         }
     } else if (errno != ENOENT && errno != ENOTDIR) {
-        (void)fail(err, errlen, "%s: %s", path, strerror(errno));
+        (void)odo_errf(err, errlen, "%s: %s", path, strerror(errno));
         odo_out_dir_abort(d);
         return NULL;
     } else {
@@ -786,13 +775,13 @@ odo_out_dir_t *odo_out_dir_begin(const char *path, const char *tool, bool force,
     for (int attempt = 0;; ++attempt) {
         const int w = snprintf(d->tmp, sizeof d->tmp, "%s/.%s.tmp-%ld-%06lx", dir, base, (long)getpid(), next_suffix());
         if (w < 0 || (size_t)w >= sizeof d->tmp) {
-            (void)fail(err, errlen, "%s: path too long", path);
+            (void)odo_errf(err, errlen, "%s: path too long", path);
             odo_out_dir_abort(d);
             return NULL;
         }
         d->tmp_reg = reg_add(d->tmp, 1);
         if (d->tmp_reg == NULL) {
-            (void)fail(err, errlen, "out of memory");
+            (void)odo_errf(err, errlen, "out of memory");
             odo_out_dir_abort(d);
             return NULL;
         }
@@ -803,7 +792,7 @@ odo_out_dir_t *odo_out_dir_begin(const char *path, const char *tool, bool force,
         reg_drop(d->tmp_reg);
         d->tmp_reg = NULL;
         if (e != EEXIST || attempt >= 100) {
-            (void)fail(err, errlen, "cannot create a temp folder beside %s: %s", path, strerror(e));
+            (void)odo_errf(err, errlen, "cannot create a temp folder beside %s: %s", path, strerror(e));
             odo_out_dir_abort(d);
             return NULL;
         }
@@ -856,18 +845,18 @@ static int make_subdirs(odo_out_dir_t *d, const char *name, char *err, size_t er
         if (!has_entry(d, rel)) {
             char full[PATH_MAX];
             if (join(full, sizeof full, d->tmp, rel) != 0) {
-                return fail(err, errlen, "%s/%s: path too long", d->path, rel);
+                return odo_errf(err, errlen, "%s/%s: path too long", d->path, rel);
             }
             reg_node_t *r = reg_add(full, 1);
             if (r == NULL || mkdir(full, 0777) != 0) {
                 const int e = errno;
                 reg_drop(r);
-                return fail(err, errlen, "cannot create %s: %s", full, strerror(e));
+                return odo_errf(err, errlen, "cannot create %s: %s", full, strerror(e));
             }
             if (add_entry(d, rel, 1, r) != 0) {
                 (void)rmdir(full);
                 reg_drop(r);
-                return fail(err, errlen, "out of memory");
+                return odo_errf(err, errlen, "out of memory");
             }
         }
         *s = '/';
@@ -878,11 +867,11 @@ static int make_subdirs(odo_out_dir_t *d, const char *name, char *err, size_t er
 FILE *odo_out_dir_fopen(odo_out_dir_t *d, const char *name, char *err, size_t errlen)
 {
     if (!name_ok(name) || strcmp(name, ODO_OUT_MANIFEST) == 0) {
-        (void)fail(err, errlen, "'%s' is not a file name an output folder may hold", name);
+        (void)odo_errf(err, errlen, "'%s' is not a file name an output folder may hold", name);
         return NULL;
     }
     if (has_entry(d, name)) {
-        (void)fail(err, errlen, "%s/%s written twice", d->path, name);
+        (void)odo_errf(err, errlen, "%s/%s written twice", d->path, name);
         return NULL;
     }
     if (make_subdirs(d, name, err, errlen) != 0) {
@@ -890,19 +879,19 @@ FILE *odo_out_dir_fopen(odo_out_dir_t *d, const char *name, char *err, size_t er
     }
     char full[PATH_MAX];
     if (join(full, sizeof full, d->tmp, name) != 0) {
-        (void)fail(err, errlen, "%s/%s: path too long", d->path, name);
+        (void)odo_errf(err, errlen, "%s/%s: path too long", d->path, name);
         return NULL;
     }
     reg_node_t *r = reg_add(full, 0);
     if (r == NULL) {
-        (void)fail(err, errlen, "out of memory");
+        (void)odo_errf(err, errlen, "out of memory");
         return NULL;
     }
     const int fd = open(full, O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0666);
     if (fd < 0) {
         const int e = errno;
         reg_drop(r);
-        (void)fail(err, errlen, "cannot create %s: %s", full, strerror(e));
+        (void)odo_errf(err, errlen, "cannot create %s: %s", full, strerror(e));
         return NULL;
     }
     FILE *f = fdopen(fd, "w");
@@ -915,7 +904,7 @@ FILE *odo_out_dir_fopen(odo_out_dir_t *d, const char *name, char *err, size_t er
         }
         (void)unlink(full);
         reg_drop(r);
-        (void)fail(err, errlen, "cannot create %s: %s", full, strerror(e));
+        (void)odo_errf(err, errlen, "cannot create %s: %s", full, strerror(e));
         return NULL;
     }
     return f;
@@ -924,17 +913,17 @@ FILE *odo_out_dir_fopen(odo_out_dir_t *d, const char *name, char *err, size_t er
 int odo_out_dir_adopt(odo_out_dir_t *d, const char *name, char *err, size_t errlen)
 {
     if (!name_ok(name) || strcmp(name, ODO_OUT_MANIFEST) == 0 || has_entry(d, name)) {
-        return fail(err, errlen, "'%s' cannot be adopted into %s", name, d->path);
+        return odo_errf(err, errlen, "'%s' cannot be adopted into %s", name, d->path);
     }
     char full[PATH_MAX];
     struct stat sb;
     if (join(full, sizeof full, d->tmp, name) != 0 || lstat(full, &sb) != 0 || !S_ISREG(sb.st_mode)) {
-        return fail(err, errlen, "%s is not a file the writer made", full);
+        return odo_errf(err, errlen, "%s is not a file the writer made", full);
     }
     reg_node_t *r = reg_add(full, 0);
     if (r == NULL || add_entry(d, name, 0, r) != 0) {
         reg_drop(r);
-        return fail(err, errlen, "out of memory");
+        return odo_errf(err, errlen, "out of memory");
     }
     return 0;
 }
@@ -944,7 +933,7 @@ static int write_manifest(const char *dir, const char *tool, char *const *names,
 {
     char path[PATH_MAX];
     if (join(path, sizeof path, dir, ODO_OUT_MANIFEST) != 0) {
-        return fail(err, errlen, "%s: path too long", dir);
+        return odo_errf(err, errlen, "%s: path too long", dir);
     }
     odo_out_file_t o;
     if (odo_out_file_begin(&o, path, NULL, err, errlen) != 0) {
@@ -983,7 +972,7 @@ int odo_out_dir_commit(odo_out_dir_t *d, char *err, size_t errlen)
     char **names = calloc(d->n_e + 1U, sizeof *names);
     size_t n = 0;
     if (names == NULL) {
-        (void)fail(err, errlen, "out of memory");
+        (void)odo_errf(err, errlen, "out of memory");
         odo_out_dir_abort(d);
         return -1;
     }
@@ -991,7 +980,7 @@ int odo_out_dir_commit(odo_out_dir_t *d, char *err, size_t errlen)
         if (!d->e[i]->is_dir) {
             names[n++] = d->e[i]->name;
             if (fsync_path(d->e[i]->reg->path) != 0) {
-                (void)fail(err, errlen, "cannot write %s: %s", d->e[i]->reg->path, strerror(errno));
+                (void)odo_errf(err, errlen, "cannot write %s: %s", d->e[i]->reg->path, strerror(errno));
                 free(names);
                 odo_out_dir_abort(d);
                 return -1;
@@ -1007,9 +996,9 @@ int odo_out_dir_commit(odo_out_dir_t *d, char *err, size_t errlen)
             /* Checked again: something may have appeared at the target during the run. */
             struct stat sb;
             if (lstat(d->path, &sb) == 0 && (!S_ISDIR(sb.st_mode) || dir_is_empty(d->path) != 1)) {
-                rc = fail(err, errlen, "%s appeared during the run; not replacing it", d->path);
+                rc = odo_errf(err, errlen, "%s appeared during the run; not replacing it", d->path);
             } else if (rename(d->tmp, d->path) != 0) {
-                rc = fail(err, errlen, "cannot rename into %s: %s", d->path, strerror(errno));
+                rc = odo_errf(err, errlen, "cannot rename into %s: %s", d->path, strerror(errno));
             }
         }
         if (rc == 0) {
@@ -1040,10 +1029,10 @@ int odo_out_dir_commit(odo_out_dir_t *d, char *err, size_t errlen)
         char dst[PATH_MAX];
         struct stat sb;
         if (join(dst, sizeof dst, d->path, d->e[i]->name) != 0) {
-            rc = fail(err, errlen, "%s/%s: path too long", d->path, d->e[i]->name);
+            rc = odo_errf(err, errlen, "%s/%s: path too long", d->path, d->e[i]->name);
         } else if (lstat(dst, &sb) == 0) {
             if (d->e[i]->is_dir ? !S_ISDIR(sb.st_mode) : !S_ISREG(sb.st_mode)) {
-                rc = fail(err, errlen, "%s is %s; refusing to replace it", dst, kind_of(sb.st_mode));
+                rc = odo_errf(err, errlen, "%s is %s; refusing to replace it", dst, kind_of(sb.st_mode));
             } else if (!d->e[i]->is_dir) {
                 rc = odo_out_check_inputs(&d->ins, dst, err, errlen);
             }
@@ -1055,7 +1044,7 @@ int odo_out_dir_commit(odo_out_dir_t *d, char *err, size_t errlen)
     if (rc == 0) {
         both = calloc(n + d->n_old + 1U, sizeof *both);
         if (both == NULL) {
-            rc = fail(err, errlen, "out of memory");
+            rc = odo_errf(err, errlen, "out of memory");
         } else {
             for (size_t i = 0; i < n; ++i) {
                 both[n_both++] = names[i];
@@ -1075,10 +1064,10 @@ int odo_out_dir_commit(odo_out_dir_t *d, char *err, size_t errlen)
         if (e->is_dir) {
             struct stat sb;
             if (lstat(dst, &sb) != 0 && mkdir(dst, 0777) != 0) {
-                rc = fail(err, errlen, "cannot create folder %s: %s", dst, strerror(errno));
+                rc = odo_errf(err, errlen, "cannot create folder %s: %s", dst, strerror(errno));
             }
         } else if (rename(e->reg->path, dst) != 0) {
-            rc = fail(err, errlen, "cannot rename into %s: %s", dst, strerror(errno));
+            rc = odo_errf(err, errlen, "cannot rename into %s: %s", dst, strerror(errno));
         } else {
             reg_drop(e->reg);
             e->reg = NULL;

@@ -1,5 +1,6 @@
 /// Robot description JSON reader and conversion to odo_params_t; see robot.h for the schema.
 #include "odo_robot.h"
+#include "odo_err.h"
 
 #include "odo/odo_odometry.h"
 
@@ -162,16 +163,10 @@ __attribute__((format(printf, 3, 4)))
 static int
 fail(const ctx_t *c, const char *field, const char *fmt, ...)
 {
-    if (c->err != NULL && c->errlen > 0) {
-        int n =
-            snprintf(c->err, c->errlen, "%s: %s%s", c->origin, field != NULL ? field : "", field != NULL ? ": " : "");
-        if (n >= 0 && (size_t)n < c->errlen) {
-            va_list ap;
-            va_start(ap, fmt);
-            vsnprintf(c->err + n, c->errlen - (size_t)n, fmt, ap);
-            va_end(ap);
-        }
-    }
+    va_list ap;
+    va_start(ap, fmt);
+    (void)odo_verrf_at(c->err, c->errlen, c->origin, field, fmt, ap);
+    va_end(ap);
     return -1;
 }
 

@@ -1,12 +1,12 @@
 /// The effects catalog and the scenario JSON reader; see effects.h for the schema.
 #include "effects.h"
+#include "odo_err.h"
 
 #include "odo_robot.h"
 
 #include <errno.h>
 #include <jansson.h>
 #include <math.h>
-#include <stdarg.h>
 #include <string.h>
 
 #define ENUM_BUMP_MODEL "paper|exact"
@@ -375,24 +375,6 @@ void sim_scenario_none(sim_scenario_t *sc)
     }
 }
 
-#if defined(__GNUC__)
-__attribute__((format(printf, 5, 6)))
-#endif
-static int
-fail(char *err, size_t errlen, const char *origin, const char *where, const char *fmt, ...)
-{
-    if (err != NULL && errlen > 0) {
-        int n = snprintf(err, errlen, "%s: %s%s", origin, where != NULL ? where : "", where != NULL ? ": " : "");
-        if (n >= 0 && (size_t)n < errlen) {
-            va_list ap;
-            va_start(ap, fmt);
-            vsnprintf(err + n, errlen - (size_t)n, fmt, ap);
-            va_end(ap);
-        }
-    }
-    return -1;
-}
-
 static const char *json_type_name(const json_t *v)
 {
     switch (json_typeof(v)) {
@@ -434,21 +416,22 @@ static int param_from_json(const sim_param_def_t *p, const json_t *v, double *ou
 {
     if (p->kind == SIM_PARAM_ENUM) {
         if (!json_is_string(v)) {
-            return fail(err, errlen, origin, where, "expected a string (%s), got %s", p->choices, json_type_name(v));
+            return odo_errf_at(err, errlen, origin, where, "expected a string (%s), got %s", p->choices,
+                               json_type_name(v));
         }
         const int idx = choice_index(p->choices, json_string_value(v));
         if (idx < 0) {
-            return fail(err, errlen, origin, where, "\"%s\" is not one of %s", json_string_value(v), p->choices);
+            return odo_errf_at(err, errlen, origin, where, "\"%s\" is not one of %s", json_string_value(v), p->choices);
         }
         *out = (double)idx;
         return 0;
     }
     if (!json_is_number(v)) {
-        return fail(err, errlen, origin, where, "expected a number (%s), got %s", p->unit, json_type_name(v));
+        return odo_errf_at(err, errlen, origin, where, "expected a number (%s), got %s", p->unit, json_type_name(v));
     }
     const double x = json_number_value(v);
     if (!isfinite(x) || x < p->min || x > p->max) {
-        return fail(err, errlen, origin, where, "%g is out of range [%g, %g] %s", x, p->min, p->max, p->unit);
+        return odo_errf_at(err, errlen, origin, where, "%g is out of range [%g, %g] %s", x, p->min, p->max, p->unit);
     }
     *out = x;
     return 0;
@@ -465,8 +448,8 @@ static int parse_truck(const json_t *v, bool allow_both, unsigned *mask, const c
     } else if (allow_both && s != NULL && strcmp(s, "both") == 0) {
         *mask = 3U;
     } else {
-        return fail(err, errlen, origin, where, "expected \"A\", \"B\"%s, got %s%s%s", allow_both ? " or \"both\"" : "",
-                    s ? "\"" : json_type_name(v), s ? s : "", s ? "\"" : "");
+        return odo_errf_at(err, errlen, origin, where, "expected \"A\", \"B\"%s, got %s%s%s",
+                           allow_both ? " or \"both\"" : "", s ? "\"" : json_type_name(v), s ? s : "", s ? "\"" : "");
     }
     return 0;
 }
@@ -477,8 +460,8 @@ static int parse_bump_list(const json_t *at, const char *prefix, double default_
     char where[160];
     snprintf(where, sizeof where, "%.140s.at", prefix);
     if (!json_is_array(at)) {
-        return fail(err, errlen, origin, where, "expected an array of {truck, wheel, distance_mm}, got %s",
-                    json_type_name(at));
+        return odo_errf_at(err, errlen, origin, where, "expected an array of {truck, wheel, distance_mm}, got %s",
+                           json_type_name(at));
     }
     static const sim_param_def_t dist = {"distance_mm", "mm", SIM_PARAM_NUMBER, 0.0, 0.0, 1.0e7, NULL, ""};
     static const sim_param_def_t height = {"height_mm", "mm", SIM_PARAM_NUMBER, 10.0, 0.0, 50.0, NULL, ""};
@@ -488,10 +471,10 @@ static int parse_bump_list(const json_t *at, const char *prefix, double default_
     {
         snprintf(where, sizeof where, "%.130s.at[%zu]", prefix, i);
         if (!json_is_object(item)) {
-            return fail(err, errlen, origin, where, "expected an object, got %s", json_type_name(item));
+            return odo_errf_at(err, errlen, origin, where, "expected an object, got %s", json_type_name(item));
         }
         if (sc->n_bumps >= SIM_SCENARIO_MAX_BUMPS) {
-            return fail(err, errlen, origin, where, "more than %d bumps", SIM_SCENARIO_MAX_BUMPS);
+            return odo_errf_at(err, errlen, origin, where, "more than %d bumps", SIM_SCENARIO_MAX_BUMPS);
         }
         sim_scenario_bump_t b = {0, 0, -1.0, default_height};
         bool have_truck = false, have_wheel = false;
@@ -515,7 +498,7 @@ static int parse_bump_list(const json_t *at, const char *prefix, double default_
                 } else if (s != NULL && strcmp(s, "right") == 0) {
                     b.wheel = ODO_RIGHT;
                 } else {
-                    return fail(err, errlen, origin, w2, "expected \"left\" or \"right\"");
+                    return odo_errf_at(err, errlen, origin, w2, "expected \"left\" or \"right\"");
                 }
                 have_wheel = true;
             } else if (strcmp(key, "distance_mm") == 0) {
@@ -527,11 +510,12 @@ static int parse_bump_list(const json_t *at, const char *prefix, double default_
                     return -1;
                 }
             } else {
-                return fail(err, errlen, origin, w2, "unknown key (known: truck, wheel, distance_mm, height_mm)");
+                return odo_errf_at(err, errlen, origin, w2,
+                                   "unknown key (known: truck, wheel, distance_mm, height_mm)");
             }
         }
         if (!have_truck || !have_wheel || b.distance_mm < 0.0) {
-            return fail(err, errlen, origin, where, "needs truck, wheel and distance_mm");
+            return odo_errf_at(err, errlen, origin, where, "needs truck, wheel and distance_mm");
         }
         sc->bump[sc->n_bumps++] = b;
     }
@@ -543,7 +527,8 @@ static int parse_instance(const sim_effect_def_t *e, const json_t *obj, const ch
                           unsigned *covered, const char *origin, char *err, size_t errlen)
 {
     if (!json_is_object(obj)) {
-        return fail(err, errlen, origin, prefix, "expected an object of parameters, got %s", json_type_name(obj));
+        return odo_errf_at(err, errlen, origin, prefix, "expected an object of parameters, got %s",
+                           json_type_name(obj));
     }
     sim_effect_setting_t s = sc->eff[e->id][0];
     s.enabled = true;
@@ -557,12 +542,12 @@ static int parse_instance(const sim_effect_def_t *e, const json_t *obj, const ch
         snprintf(where, sizeof where, "%.140s.%.50s", prefix, key);
         if (strcmp(key, "enabled") == 0) {
             if (!json_is_boolean(v)) {
-                return fail(err, errlen, origin, where, "expected true or false, got %s", json_type_name(v));
+                return odo_errf_at(err, errlen, origin, where, "expected true or false, got %s", json_type_name(v));
             }
             s.enabled = json_is_true(v);
         } else if (strcmp(key, "truck") == 0) {
             if (e->scope != SIM_SCOPE_TRUCK) {
-                return fail(err, errlen, origin, where, "'%s' is a vehicle effect: no truck selection", e->name);
+                return odo_errf_at(err, errlen, origin, where, "'%s' is a vehicle effect: no truck selection", e->name);
             }
             if (parse_truck(v, true, &mask, origin, where, err, errlen) != 0) {
                 return -1;
@@ -574,9 +559,9 @@ static int parse_instance(const sim_effect_def_t *e, const json_t *obj, const ch
             if (k < 0) {
                 char known[160];
                 known_params(e, known, sizeof known);
-                return fail(err, errlen, origin, where, "unknown parameter of '%s' (known: %s%s, enabled%s)", e->name,
-                            known, e->scope == SIM_SCOPE_TRUCK ? ", truck" : "",
-                            e->id == SIM_EFFECT_BUMPS ? ", at" : "");
+                return odo_errf_at(err, errlen, origin, where, "unknown parameter of '%s' (known: %s%s, enabled%s)",
+                                   e->name, known, e->scope == SIM_SCOPE_TRUCK ? ", truck" : "",
+                                   e->id == SIM_EFFECT_BUMPS ? ", at" : "");
             }
             if (param_from_json(&e->params[k], v, &s.p[k], origin, where, err, errlen) != 0) {
                 return -1;
@@ -588,7 +573,7 @@ static int parse_instance(const sim_effect_def_t *e, const json_t *obj, const ch
             continue;
         }
         if ((*covered & (1U << t)) != 0U) {
-            return fail(err, errlen, origin, prefix, "truck %c is set twice for '%s'", (char)('A' + t), e->name);
+            return odo_errf_at(err, errlen, origin, prefix, "truck %c is set twice for '%s'", (char)('A' + t), e->name);
         }
         *covered |= 1U << t;
         sc->eff[e->id][t] = s;
@@ -603,7 +588,7 @@ static int parse_root(const json_t *root, const char *origin, sim_scenario_t *sc
 {
     sim_scenario_none(sc);
     if (!json_is_object(root)) {
-        return fail(err, errlen, origin, NULL, "a scenario is a JSON object, got %s", json_type_name(root));
+        return odo_errf_at(err, errlen, origin, NULL, "a scenario is a JSON object, got %s", json_type_name(root));
     }
     const char *key;
     json_t *v;
@@ -611,20 +596,21 @@ static int parse_root(const json_t *root, const char *origin, sim_scenario_t *sc
     {
         if (strcmp(key, "description") != 0 && strcmp(key, "seed") != 0 && strcmp(key, "bump_model") != 0 &&
             strcmp(key, "effects") != 0) {
-            return fail(err, errlen, origin, key, "unknown key (known: description, seed, bump_model, effects)");
+            return odo_errf_at(err, errlen, origin, key, "unknown key (known: description, seed, bump_model, effects)");
         }
     }
     const json_t *d = json_object_get(root, "description");
     if (d != NULL) {
         if (!json_is_string(d)) {
-            return fail(err, errlen, origin, "description", "expected a string, got %s", json_type_name(d));
+            return odo_errf_at(err, errlen, origin, "description", "expected a string, got %s", json_type_name(d));
         }
         snprintf(sc->description, sizeof sc->description, "%s", json_string_value(d));
     }
     const json_t *seed = json_object_get(root, "seed");
     if (seed != NULL) {
         if (!json_is_integer(seed) || json_integer_value(seed) < 0) {
-            return fail(err, errlen, origin, "seed", "expected a non-negative integer, got %s", json_type_name(seed));
+            return odo_errf_at(err, errlen, origin, "seed", "expected a non-negative integer, got %s",
+                               json_type_name(seed));
         }
         sc->seed = (uint64_t)json_integer_value(seed);
         sc->has_seed = true;
@@ -633,7 +619,7 @@ static int parse_root(const json_t *root, const char *origin, sim_scenario_t *sc
     if (bm != NULL) {
         sim_bump_model_t m;
         if (!json_is_string(bm) || !sim_bump_model_parse(json_string_value(bm), &m)) {
-            return fail(err, errlen, origin, "bump_model", "expected \"paper\" or \"exact\"");
+            return odo_errf_at(err, errlen, origin, "bump_model", "expected \"paper\" or \"exact\"");
         }
         for (unsigned t = 0; t < ODO_TRUCKS; ++t) {
             sc->eff[SIM_EFFECT_BUMPS][t].p[SIM_P_BUMPS_MODEL] = (double)m;
@@ -642,10 +628,10 @@ static int parse_root(const json_t *root, const char *origin, sim_scenario_t *sc
     }
     const json_t *effects = json_object_get(root, "effects");
     if (effects == NULL) {
-        return fail(err, errlen, origin, NULL, "missing \"effects\" (use {} for none)");
+        return odo_errf_at(err, errlen, origin, NULL, "missing \"effects\" (use {} for none)");
     }
     if (!json_is_object(effects)) {
-        return fail(err, errlen, origin, "effects", "expected an object, got %s", json_type_name(effects));
+        return odo_errf_at(err, errlen, origin, "effects", "expected an object, got %s", json_type_name(effects));
     }
     json_object_foreach((json_t *)effects, key, v)
     {
@@ -655,12 +641,12 @@ static int parse_root(const json_t *root, const char *origin, sim_scenario_t *sc
         if (e == NULL) {
             char known[256];
             known_effects(known, sizeof known);
-            return fail(err, errlen, origin, prefix, "unknown effect (known: %s)", known);
+            return odo_errf_at(err, errlen, origin, prefix, "unknown effect (known: %s)", known);
         }
         unsigned covered = 0U;
         if (json_is_array(v)) {
             if (e->scope == SIM_SCOPE_VEHICLE) {
-                return fail(err, errlen, origin, prefix, "'%s' is a vehicle effect: give one object", e->name);
+                return odo_errf_at(err, errlen, origin, prefix, "'%s' is a vehicle effect: give one object", e->name);
             }
             size_t i;
             json_t *item;
@@ -683,8 +669,8 @@ static int parse_loaded(json_t *root, const json_error_t *jerr, const char *orig
                         size_t errlen)
 {
     if (root == NULL) {
-        return fail(err, errlen, origin, NULL, "malformed JSON at line %d column %d: %s", jerr->line, jerr->column,
-                    jerr->text);
+        return odo_errf_at(err, errlen, origin, NULL, "malformed JSON at line %d column %d: %s", jerr->line,
+                           jerr->column, jerr->text);
     }
     const int rc = parse_root(root, origin, sc, err, errlen);
     json_decref(root);
@@ -698,7 +684,7 @@ int sim_scenario_parse_string(const char *json, const char *origin, sim_scenario
         origin = "<string>";
     }
     if (json == NULL || sc == NULL) {
-        return fail(err, errlen, origin, NULL, "no input");
+        return odo_errf_at(err, errlen, origin, NULL, "no input");
     }
     return parse_loaded(json_loads(json, JSON_REJECT_DUPLICATES, &jerr), &jerr, origin, sc, err, errlen);
 }
@@ -706,11 +692,11 @@ int sim_scenario_parse_string(const char *json, const char *origin, sim_scenario
 int sim_scenario_parse_file(const char *path, sim_scenario_t *sc, char *err, size_t errlen)
 {
     if (path == NULL || sc == NULL) {
-        return fail(err, errlen, "<scenario>", NULL, "no file given");
+        return odo_errf_at(err, errlen, "<scenario>", NULL, "no file given");
     }
     FILE *f = fopen(path, "rb");
     if (f == NULL) {
-        return fail(err, errlen, path, NULL, "cannot open scenario: %s", strerror(errno));
+        return odo_errf_at(err, errlen, path, NULL, "cannot open scenario: %s", strerror(errno));
     }
     json_error_t jerr;
     json_t *root = json_loadf(f, JSON_REJECT_DUPLICATES, &jerr);
@@ -725,7 +711,7 @@ int sim_scenario_set(sim_scenario_t *sc, const char *effect, const char *param, 
     if (e == NULL) {
         char known[256];
         known_effects(known, sizeof known);
-        return fail(err, errlen, "scenario", effect, "unknown effect (known: %s)", known);
+        return odo_errf_at(err, errlen, "scenario", effect, "unknown effect (known: %s)", known);
     }
     int k = -1;
     if (param != NULL) {
@@ -733,13 +719,13 @@ int sim_scenario_set(sim_scenario_t *sc, const char *effect, const char *param, 
         if (k < 0) {
             char known[160];
             known_params(e, known, sizeof known);
-            return fail(err, errlen, "scenario", effect, "unknown parameter '%s' (known: %s)", param, known);
+            return odo_errf_at(err, errlen, "scenario", effect, "unknown parameter '%s' (known: %s)", param, known);
         }
         const sim_param_def_t *p = &e->params[k];
         if (!isfinite(value) || value < p->min || value > p->max ||
             (p->kind == SIM_PARAM_ENUM && value != floor(value))) {
-            return fail(err, errlen, "scenario", effect, "%s = %g is out of range [%g, %g] %s", param, value, p->min,
-                        p->max, p->unit);
+            return odo_errf_at(err, errlen, "scenario", effect, "%s = %g is out of range [%g, %g] %s", param, value,
+                               p->min, p->max, p->unit);
         }
     }
     if (e->scope == SIM_SCOPE_VEHICLE) {

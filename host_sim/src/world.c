@@ -1,8 +1,8 @@
 /// True kinematics with effects; see world.h for the model and its conventions.
 #include "world.h"
+#include "odo_err.h"
 
 #include <math.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -23,21 +23,6 @@ static uint64_t splitmix64(uint64_t *s)
 }
 
 static double uniform01(uint64_t *s) { return (double)(splitmix64(s) >> 11) * (1.0 / 9007199254740992.0); }
-
-#if defined(__GNUC__)
-__attribute__((format(printf, 3, 4)))
-#endif
-static int
-fail(char *err, size_t errlen, const char *fmt, ...)
-{
-    if (err != NULL && errlen > 0) {
-        va_list ap;
-        va_start(ap, fmt);
-        vsnprintf(err, errlen, fmt, ap);
-        va_end(ap);
-    }
-    return -1;
-}
 
 static double wrap_pi(double a)
 {
@@ -86,10 +71,10 @@ static int truck_radii(sim_world_t *w, unsigned t, char *err, size_t errlen)
         const double off = eff_p(w, SIM_EFFECT_TIRE_COMPRESSION, t, SIM_P_TIRE_OFFSET);
         const double b = d->wheelbase_mm;
         if (fabs(off) >= 0.5 * b) {
-            return fail(err, errlen,
-                        "tire_compression.lateral_offset_mm: |%g| must be below half the "
-                        "wheelbase of truck %c (%g mm)",
-                        off, (char)('A' + t), 0.5 * b);
+            return odo_errf(err, errlen,
+                            "tire_compression.lateral_offset_mm: |%g| must be below half the "
+                            "wheelbase of truck %c (%g mm)",
+                            off, (char)('A' + t), 0.5 * b);
         }
         /* Static lever rule: the load sits `off` left of the centre. */
         r[ODO_LEFT] -= k * m * (0.5 * b + off) / b;
@@ -97,8 +82,8 @@ static int truck_radii(sim_world_t *w, unsigned t, char *err, size_t errlen)
     }
     for (unsigned wh = 0; wh < 2U; ++wh) {
         if (!(r[wh] > 1.0)) {
-            return fail(err, errlen, "truck %c %s wheel: the effects leave a radius of %g mm", (char)('A' + t),
-                        wh == ODO_LEFT ? "left" : "right", r[wh]);
+            return odo_errf(err, errlen, "truck %c %s wheel: the effects leave a radius of %g mm", (char)('A' + t),
+                            wh == ODO_LEFT ? "left" : "right", r[wh]);
         }
         ts->wheel[wh].radius_mm = r[wh];
     }
@@ -118,14 +103,14 @@ int sim_world_init(sim_world_t *w, const sim_robot_t *robot, const sim_scenario_
                    size_t errlen)
 {
     if (w == NULL || robot == NULL || sc == NULL) {
-        return fail(err, errlen, "sim_world_init: NULL argument");
+        return odo_errf(err, errlen, "sim_world_init: NULL argument");
     }
     memset(w, 0, sizeof *w);
     w->robot = *robot;
     w->sc = *sc;
     w->seed = seed;
     if (w->robot.n_trucks < 1U || w->robot.n_trucks > ODO_TRUCKS) {
-        return fail(err, errlen, "sim_world_init: robot has %u trucks", w->robot.n_trucks);
+        return odo_errf(err, errlen, "sim_world_init: robot has %u trucks", w->robot.n_trucks);
     }
     for (unsigned t = 0; t < n_trucks(w); ++t) {
         if (truck_radii(w, t, err, errlen) != 0) {
@@ -144,15 +129,16 @@ int sim_world_init(sim_world_t *w, const sim_robot_t *robot, const sim_scenario_
     for (size_t i = 0; i < sc->n_bumps; ++i) {
         const sim_scenario_bump_t *b = &sc->bump[i];
         if (b->truck >= n_trucks(w)) {
-            return fail(err, errlen, "scenario bump %zu is under truck B, but a %s has one truck", i,
-                        sim_vehicle_name(w->robot.vehicle));
+            return odo_errf(err, errlen, "scenario bump %zu is under truck B, but a %s has one truck", i,
+                            sim_vehicle_name(w->robot.vehicle));
         }
         if (!eff_on(w, SIM_EFFECT_BUMPS, b->truck)) {
             continue;
         }
         if (sim_world_add_bump(w, b->truck, b->wheel, b->distance_mm, b->height_mm) != 0) {
-            return fail(err, errlen, "scenario bump %zu (height %g mm at %g mm) does not fit under truck %c's wheel", i,
-                        b->height_mm, b->distance_mm, (char)('A' + b->truck));
+            return odo_errf(err, errlen,
+                            "scenario bump %zu (height %g mm at %g mm) does not fit under truck %c's wheel", i,
+                            b->height_mm, b->distance_mm, (char)('A' + b->truck));
         }
     }
     sim_world_place(w, 0.0, 0.0, 0.0);
@@ -332,17 +318,17 @@ static double slip_factor(const sim_world_t *w, unsigned t, double cmd, double p
 int sim_world_set_hidden(sim_world_t *w, const sim_hidden_t *h, char *err, size_t errlen)
 {
     if (w == NULL || h == NULL) {
-        return fail(err, errlen, "sim_world_set_hidden: NULL argument");
+        return odo_errf(err, errlen, "sim_world_set_hidden: NULL argument");
     }
     const double v[5] = {h->motor_tau_s, fabs(h->diam_var_amp), h->diam_var_period_s, fabs(h->diam_drift_per_s),
                          h->backlash_rad};
     for (size_t i = 0; i < 5; ++i) {
         if (!isfinite(v[i]) || v[i] < 0.0) {
-            return fail(err, errlen, "hidden effect %zu: %g is not a finite non-negative value", i, v[i]);
+            return odo_errf(err, errlen, "hidden effect %zu: %g is not a finite non-negative value", i, v[i]);
         }
     }
     if (fabs(h->diam_var_amp) >= 0.5 || (h->diam_var_amp != 0.0 && !(h->diam_var_period_s > 0.0))) {
-        return fail(err, errlen, "hidden diameter variation: |amp| < 0.5 and a positive period needed");
+        return odo_errf(err, errlen, "hidden diameter variation: |amp| < 0.5 and a positive period needed");
     }
     w->hidden = *h;
     return 0;

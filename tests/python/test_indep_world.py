@@ -337,6 +337,7 @@ def test_bump_turns_the_truck_by_the_exact_step_geometry(tmp_path: Path) -> None
     assert abs(got / want - 1) < 0.01, (got, want)
     (ev,) = extra["events"]
     assert ev["wheel"] == "right" and ev["run"] == "run-straight-01"
+    assert json.loads(json.dumps(extra))["events"] == [ev]  # the key's events are plain JSON
     assert abs(ev["x_mm"] - 1500.0) < 0.5 * math.sqrt(2 * R * h) + 5 and abs(ev["y_mm"] + b / 2) < 5
 
 
@@ -436,3 +437,16 @@ def test_same_seed_same_bytes_another_seed_differs(tmp_path: Path) -> None:
     assert any((a / f).read_bytes() != (d / f).read_bytes() for f in files if f != "robot.json")
     with pytest.raises(FileExistsError):
         indep.simulate_case(c, a, 17)
+
+
+def test_a_drawn_bump_cases_key_is_plain_json(tmp_path: Path) -> None:
+    """The key's bump events come out of numpy arrays (cable indices were int64, and `--key`
+    failed after the data were written); every value in the key must be plain JSON."""
+    rng = np.random.default_rng(7)
+    for k in range(22):  # seed 7 case 21: a drawn floor with bumps
+        c = indep.draw_case(rng, k)
+    assert c["effects"] == ["bumps"]
+    c["plan"] = c["plan"][:1]
+    extra = indep.simulate_case(c, tmp_path / "real", 7)
+    assert extra["events"], "the first run crosses a cable"
+    assert json.loads(json.dumps(extra)) == extra

@@ -1,11 +1,11 @@
 /// Recorded runs for `odo-calib fit` (fit_data.h).
 #include "fit_data.h"
+#include "odo_err.h"
 
 #include <errno.h>
 #include <fnmatch.h>
 #include <glob.h>
 #include <math.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -14,19 +14,6 @@
 #include "odo/odo_odometry.h"
 #include "replay.h"
 #include "odo_robot.h"
-
-#if defined(__GNUC__)
-__attribute__((format(printf, 3, 4)))
-#endif
-static int
-fail(char *err, size_t errlen, const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(err, errlen, fmt, ap);
-    va_end(ap);
-    return -1;
-}
 
 /* ---------------------------------------------------------------------------------------------
  * Counts: the log through the firmware's tick assembler; the deltas the firmware's odometry
@@ -88,11 +75,11 @@ static int load_counts(fit_run_t *run, const odo_params_t *p, uint64_t *fd_skipp
     const odo_pose_t origin = {0, 0, 0};
     odo_truck_reset(&c.shadow, &origin);
     if (replay_init(&rp, p, on_tick, &c) != ODO_PARAMS_OK) {
-        return fail(err, errlen, "%s: the robot's parameter block does not boot the firmware", run->log_path);
+        return odo_errf(err, errlen, "%s: the robot's parameter block does not boot the firmware", run->log_path);
     }
     hal_log_t lg;
     if (hal_log_open(&lg, run->log_path) != 0) {
-        return fail(err, errlen, "%s", lg.err);
+        return odo_errf(err, errlen, "%s", lg.err);
     }
     candump_line_t l;
     hal_log_status_t st;
@@ -101,22 +88,22 @@ static int load_counts(fit_run_t *run, const odo_params_t *p, uint64_t *fd_skipp
     }
     *fd_skipped += lg.stats.fd_skipped;
     if (st == HAL_LOG_ERROR) {
-        fail(err, errlen, "%s", lg.err);
+        odo_errf(err, errlen, "%s", lg.err);
         hal_log_close(&lg);
         return -1;
     }
     hal_log_close(&lg);
     replay_finish(&rp);
     if (c.oom) {
-        return fail(err, errlen, "%s: out of memory", run->log_path);
+        return odo_errf(err, errlen, "%s: out of memory", run->log_path);
     }
     if (rp.stats.sensor_frames == 0 || run->n < 2) {
-        return fail(err, errlen, "%s: no WHEEL_COUNTS_A frames (a log of another robot or no sensor log)",
-                    run->log_path);
+        return odo_errf(err, errlen, "%s: no WHEEL_COUNTS_A frames (a log of another robot or no sensor log)",
+                        run->log_path);
     }
     if (rp.stats.time_backwards != 0) {
-        return fail(err, errlen, "%s: time goes backwards in the log (%llu frames)", run->log_path,
-                    (unsigned long long)rp.stats.time_backwards);
+        return odo_errf(err, errlen, "%s: time goes backwards in the log (%llu frames)", run->log_path,
+                        (unsigned long long)rp.stats.time_backwards);
     }
     return 0;
 }
@@ -128,7 +115,7 @@ static int load_track(fit_run_t *run, const char *path, char *err, size_t errlen
 {
     FILE *f = fopen(path, "r");
     if (f == NULL) {
-        return fail(err, errlen, "%s: cannot open: %s", path, strerror(errno));
+        return odo_errf(err, errlen, "%s: cannot open: %s", path, strerror(errno));
     }
     size_t cap = 4096, n = 0;
     double *a = malloc(cap * 4 * sizeof *a);
@@ -139,7 +126,7 @@ static int load_track(fit_run_t *run, const char *path, char *err, size_t errlen
         ln++;
         if (ln == 1) {
             if (strncmp(line, "t_s,a_x_mm,a_y_mm,a_theta_deg", 29) != 0) {
-                rc = fail(err, errlen, "%s:1: expected a header starting t_s,a_x_mm,a_y_mm,a_theta_deg", path);
+                rc = odo_errf(err, errlen, "%s:1: expected a header starting t_s,a_x_mm,a_y_mm,a_theta_deg", path);
                 break;
             }
             continue;
@@ -154,7 +141,7 @@ static int load_track(fit_run_t *run, const char *path, char *err, size_t errlen
             v[k] = strtod(s, &e);
             if (e == s || errno != 0 || !isfinite(v[k]) ||
                 (*e != ',' && !(k == 3 && (*e == '\n' || *e == '\r' || *e == '\0')))) {
-                rc = fail(err, errlen, "%s:%u: field %d is not a finite number", path, ln, k + 1);
+                rc = odo_errf(err, errlen, "%s:%u: field %d is not a finite number", path, ln, k + 1);
             }
             s = e + 1;
         }
@@ -162,7 +149,7 @@ static int load_track(fit_run_t *run, const char *path, char *err, size_t errlen
             break;
         }
         if (n > 0 && !(v[0] > a[4 * (n - 1)])) {
-            rc = fail(err, errlen, "%s:%u: time %.6g does not increase (time goes backwards)", path, ln, v[0]);
+            rc = odo_errf(err, errlen, "%s:%u: time %.6g does not increase (time goes backwards)", path, ln, v[0]);
             break;
         }
         if (n == cap) {
@@ -178,18 +165,18 @@ static int load_track(fit_run_t *run, const char *path, char *err, size_t errlen
     }
     fclose(f);
     if (a == NULL) {
-        return fail(err, errlen, "%s: out of memory", path);
+        return odo_errf(err, errlen, "%s: out of memory", path);
     }
     if (rc == 0 && n < 2) {
-        rc = fail(err, errlen, "%s: fewer than 2 truth samples", path);
+        rc = odo_errf(err, errlen, "%s: fewer than 2 truth samples", path);
     }
     if (rc == 0) {
         const double t_end = run->t_s[run->n - 1], tick = run->n > 1 ? run->t_s[1] - run->t_s[0] : 0.0;
         if (a[0] > run->t_s[0] + 0.5 * tick || a[4 * (n - 1)] < t_end - 0.5 * tick) {
-            rc = fail(err, errlen,
-                      "%s: the truth track covers %.3f-%.3f s but the log %s has %zu ticks over %.3f-%.3f s "
-                      "(mismatched ticks/truth lengths)",
-                      path, a[0], a[4 * (n - 1)], run->log_path, run->n, run->t_s[0], t_end);
+            rc = odo_errf(err, errlen,
+                          "%s: the truth track covers %.3f-%.3f s but the log %s has %zu ticks over %.3f-%.3f s "
+                          "(mismatched ticks/truth lengths)",
+                          path, a[0], a[4 * (n - 1)], run->log_path, run->n, run->t_s[0], t_end);
         }
     }
     if (rc == 0) {
@@ -197,7 +184,7 @@ static int load_track(fit_run_t *run, const char *path, char *err, size_t errlen
         run->ty_mm = malloc(run->n * sizeof(double));
         run->tth_rad = malloc(run->n * sizeof(double));
         if (run->tx_mm == NULL || run->ty_mm == NULL || run->tth_rad == NULL) {
-            rc = fail(err, errlen, "%s: out of memory", path);
+            rc = odo_errf(err, errlen, "%s: out of memory", path);
         }
     }
     if (rc == 0) {
@@ -250,7 +237,7 @@ static int load_return(fit_run_t *run, const char *path, const char *dir_word, u
         ln++;
         if (ln == 1) {
             if (strncmp(line, "run,direction,x_abs_mm,y_abs_mm,theta_abs_deg", 45) != 0) {
-                rc = fail(err, errlen, "%s:1: expected the returns.csv header (run,direction,x_abs_mm,...)", path);
+                rc = odo_errf(err, errlen, "%s:1: expected the returns.csv header (run,direction,x_abs_mm,...)", path);
                 break;
             }
             continue;
@@ -261,7 +248,7 @@ static int load_return(fit_run_t *run, const char *path, const char *dir_word, u
         if (sscanf(line, "%u,%15[a-z],%lf,%lf,%lf", &r, d, &x, &y, &th) != 5 || !isfinite(x) || !isfinite(y) ||
             !isfinite(th)) {
             if (line[0] != '\n' && line[0] != '#') {
-                rc = fail(err, errlen, "%s:%u: malformed row", path, ln);
+                rc = odo_errf(err, errlen, "%s:%u: malformed row", path, ln);
                 break;
             }
             continue;
@@ -292,7 +279,7 @@ static int check_robot(const char *dir, const char *robot_path, const odo_params
     odo_params_t q;
     char e[512];
     if (sim_robot_parse_file(path, &r, e, sizeof e) != 0 || sim_robot_to_params(&r, &q, e, sizeof e) != 0) {
-        return fail(err, errlen, "%s", e);
+        return odo_errf(err, errlen, "%s", e);
     }
     const odo_truck_params_t *a = &p->truck[0], *b = &q.truck[0];
     const char *what = NULL;
@@ -311,7 +298,7 @@ static int check_robot(const char *dir, const char *robot_path, const odo_params
     else if (p->vehicle != q.vehicle)
         what = "vehicle";
     if (what != NULL) {
-        return fail(err, errlen, "%s: runs of a different robot: %s differs from %s", path, what, robot_path);
+        return odo_errf(err, errlen, "%s: runs of a different robot: %s differs from %s", path, what, robot_path);
     }
     return 0;
 }
@@ -320,7 +307,7 @@ int fit_data_load_dir(fit_set_t *s, const char *dir, const char *robot_path, con
                       size_t errlen)
 {
     if (s->n_groups == FIT_MAX_GROUPS) {
-        return fail(err, errlen, "%s: more than %u folders", dir, FIT_MAX_GROUPS);
+        return odo_errf(err, errlen, "%s: more than %u folders", dir, FIT_MAX_GROUPS);
     }
     if (check_robot(dir, robot_path, p, err, errlen) != 0) {
         return -1;
@@ -331,9 +318,9 @@ int fit_data_load_dir(fit_set_t *s, const char *dir, const char *robot_path, con
     const int gr = glob(pat, 0, NULL, &g);
     if (gr != 0) {
         if (gr == GLOB_NOMATCH) {
-            return fail(err, errlen, "%s: no run-*.log files (a folder odo-import writes)", dir);
+            return odo_errf(err, errlen, "%s: no run-*.log files (a folder odo-import writes)", dir);
         }
-        return fail(err, errlen, "%s: cannot list the folder", dir);
+        return odo_errf(err, errlen, "%s: cannot list the folder", dir);
     }
     const unsigned group = (unsigned)s->n_groups;
     /* group name: the folder's last path component */
@@ -348,7 +335,7 @@ int fit_data_load_dir(fit_set_t *s, const char *dir, const char *robot_path, con
     for (size_t k = 0; k < s->n_groups; ++k) {
         if (strcmp(s->group_name[k], base) == 0) {
             globfree(&g);
-            return fail(err, errlen, "%s: two folders named %s (run names would clash)", dir, base);
+            return odo_errf(err, errlen, "%s: two folders named %s (run names would clash)", dir, base);
         }
     }
     snprintf(s->group_name[group], sizeof s->group_name[group], "%.95s", base);
@@ -357,7 +344,7 @@ int fit_data_load_dir(fit_set_t *s, const char *dir, const char *robot_path, con
     int rc = 0;
     for (size_t i = 0; i < g.gl_pathc && rc == 0; ++i) {
         if (s->n_runs == FIT_MAX_RUNS) {
-            rc = fail(err, errlen, "%s: more than %u runs", dir, FIT_MAX_RUNS);
+            rc = odo_errf(err, errlen, "%s: more than %u runs", dir, FIT_MAX_RUNS);
             break;
         }
         fit_run_t *run = &s->run[s->n_runs];
@@ -389,8 +376,8 @@ int fit_data_load_dir(fit_set_t *s, const char *dir, const char *robot_path, con
                 rc = load_return(run, rp, d, idx, err, errlen);
             }
             if (rc == 0 && !run->has_return) {
-                rc = fail(err, errlen, "%s: no truth (neither %s.truth.csv nor a row in returns.csv)", run->log_path,
-                          stem);
+                rc = odo_errf(err, errlen, "%s: no truth (neither %s.truth.csv nor a row in returns.csv)",
+                              run->log_path, stem);
             }
         }
     }
@@ -417,8 +404,9 @@ int fit_data_select(fit_set_t *s, const char *const *fit, size_t n_fit, const ch
                 }
             }
             if (!any) {
-                return fail(err, errlen, "%s '%s' matches no run (runs are named <folder>/<log stem>, e.g. %s)",
-                            w == 0 ? "--fit" : "--judge", pats[w][k], s->n_runs ? s->run[0].name : "square/run-cw-01");
+                return odo_errf(err, errlen, "%s '%s' matches no run (runs are named <folder>/<log stem>, e.g. %s)",
+                                w == 0 ? "--fit" : "--judge", pats[w][k],
+                                s->n_runs ? s->run[0].name : "square/run-cw-01");
             }
         }
     }
@@ -433,7 +421,7 @@ int fit_data_select(fit_set_t *s, const char *const *fit, size_t n_fit, const ch
         n_fitted += s->run[i].fit;
     }
     if (n_fitted == 0) {
-        return fail(err, errlen, "no run selected for fitting");
+        return odo_errf(err, errlen, "no run selected for fitting");
     }
     return 0;
 }
@@ -462,11 +450,11 @@ int fit_data_firmware_track(const fit_run_t *run, const odo_params_t *block, dou
     static replay_t rp;
     poses_t ps = {x, y, 0, run->n};
     if (replay_init(&rp, block, on_pose, &ps) != ODO_PARAMS_OK) {
-        return fail(err, errlen, "%s: the fitted block does not boot the firmware", run->log_path);
+        return odo_errf(err, errlen, "%s: the fitted block does not boot the firmware", run->log_path);
     }
     hal_log_t lg;
     if (hal_log_open(&lg, run->log_path) != 0) {
-        return fail(err, errlen, "%s", lg.err);
+        return odo_errf(err, errlen, "%s", lg.err);
     }
     candump_line_t l;
     hal_log_status_t st;
@@ -476,7 +464,7 @@ int fit_data_firmware_track(const fit_run_t *run, const odo_params_t *block, dou
     hal_log_close(&lg);
     replay_finish(&rp);
     if (st == HAL_LOG_ERROR || ps.n != run->n) {
-        return fail(err, errlen, "%s: changed while reading (%zu ticks, then %zu)", run->log_path, run->n, ps.n);
+        return odo_errf(err, errlen, "%s: changed while reading (%zu ticks, then %zu)", run->log_path, run->n, ps.n);
     }
     return 0;
 }

@@ -1,11 +1,11 @@
 /// `odo-calib fit`: the model and its least-squares fit (fit_model.h).
 #include "fit_model.h"
+#include "odo_err.h"
 
 #include <gsl/gsl_blas.h>
 #include <gsl/gsl_multifit_nlinear.h>
 #include <gsl/gsl_vector.h>
 #include <math.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -186,19 +186,6 @@ void fit_return_error(const fit_run_t *run, const odo_truck_params_t *base, unsi
     e->pos_mm = hypot(e->ex_mm, e->ey_mm);
 }
 
-#if defined(__GNUC__)
-__attribute__((format(printf, 3, 4)))
-#endif
-static int
-fail(char *err, size_t errlen, const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(err, errlen, fmt, ap);
-    va_end(ap);
-    return -1;
-}
-
 int fit_run_fit(const fit_set_t *s, const odo_truck_params_t *base, unsigned heading_form, const fit_params_t *start,
                 fit_free_t free_, fit_result_t *out, char *err, size_t errlen)
 {
@@ -226,10 +213,10 @@ int fit_run_fit(const fit_set_t *s, const odo_truck_params_t *base, unsigned hea
     }
     const size_t nr = n_residuals(s);
     if (c.np == 0) {
-        return fail(err, errlen, "nothing to fit: every parameter is fixed");
+        return odo_errf(err, errlen, "nothing to fit: every parameter is fixed");
     }
     if (nr < c.np) {
-        return fail(err, errlen, "%zu residuals for %zu unknowns: fit more runs", nr, c.np);
+        return odo_errf(err, errlen, "%zu residuals for %zu unknowns: fit more runs", nr, c.np);
     }
     c.bx = malloc(longest * sizeof(double));
     c.by = malloc(longest * sizeof(double));
@@ -258,7 +245,7 @@ int fit_run_fit(const fit_set_t *s, const odo_truck_params_t *base, unsigned hea
     gsl_multifit_nlinear_workspace *w = gsl_multifit_nlinear_alloc(gsl_multifit_nlinear_trust, &fp, nr, c.np);
     int rc = 0;
     if (c.bx == NULL || c.by == NULL || c.bth == NULL || x == NULL || w == NULL) {
-        rc = fail(err, errlen, "out of memory (%zu residuals x %zu unknowns)", nr, c.np);
+        rc = odo_errf(err, errlen, "out of memory (%zu residuals x %zu unknowns)", nr, c.np);
     }
     int info = 0;
     gsl_error_handler_t *old = gsl_set_error_handler_off();
@@ -297,13 +284,13 @@ int fit_run_fit(const fit_set_t *s, const odo_truck_params_t *base, unsigned hea
         }
         gsl_matrix_free(cov);
         if (!out->converged) {
-            rc = fail(err, errlen, "the fit did not converge in %d iterations", out->iterations);
+            rc = odo_errf(err, errlen, "the fit did not converge in %d iterations", out->iterations);
         } else if (fabs(out->p.k) > FIT_SCRUB_MAX || fabs(out->p.ed - 1.0) > 0.2 || fabs(out->p.eb - 1.0) > 0.2 ||
                    fabs(out->p.es - 1.0) > 0.2) {
-            rc = fail(err, errlen,
-                      "fitted parameters out of the block's range (Ed %.5f, Eb %.5f, Es %.5f, scrub %.5f): "
-                      "runs of another robot, or a wrong robot description?",
-                      out->p.ed, out->p.eb, out->p.es, out->p.k);
+            rc = odo_errf(err, errlen,
+                          "fitted parameters out of the block's range (Ed %.5f, Eb %.5f, Es %.5f, scrub %.5f): "
+                          "runs of another robot, or a wrong robot description?",
+                          out->p.ed, out->p.eb, out->p.es, out->p.k);
         }
     }
     gsl_set_error_handler(old);

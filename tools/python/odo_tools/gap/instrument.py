@@ -244,17 +244,23 @@ def latency(
     c, s_ = np.cos(tp[i, 2]), np.sin(tp[i, 2])
     dlong = c * (tp[j, 0] - tp[i, 0]) + s_ * (tp[j, 1] - tp[i, 1])
 
-    def resid(L: float) -> np.ndarray:
-        tm = tt - L
-        ok = (tm[i] >= pr.t[0]) & (tm[j] <= pr.t[-1])
-        m = np.column_stack([np.interp(tm, pr.t, p[:, k]) for k in range(3)])
-        cm, sm = np.cos(m[i, 2]), np.sin(m[i, 2])
-        ml = cm * (m[j, 0] - m[i, 0]) + sm * (m[j, 1] - m[i, 1])
-        r = np.concatenate([(dth - (m[j, 2] - m[i, 2])) * half_b, dlong - ml])
-        return np.where(np.concatenate([ok, ok]), r, np.nan)
+    # the model is needed at the windows' ends only (np.interp is pointwise: same numbers)
+    ends = np.union1d(i, j)
+    ie, je = np.searchsorted(ends, i), np.searchsorted(ends, j)
+    t_ends = tt[ends]
+
+    def resid(L: np.ndarray) -> np.ndarray:
+        """(shifts, 2 x windows): the residuals under every shift L (s) at once."""
+        tm = t_ends[None, :] - L[:, None]
+        ok = (tm[:, ie] >= pr.t[0]) & (tm[:, je] <= pr.t[-1])
+        mx, my, mth = (np.interp(tm, pr.t, p[:, k]) for k in range(3))
+        cm, sm = np.cos(mth[:, ie]), np.sin(mth[:, ie])
+        ml = cm * (mx[:, je] - mx[:, ie]) + sm * (my[:, je] - my[:, ie])
+        r = np.concatenate([(dth - (mth[:, je] - mth[:, ie])) * half_b, dlong - ml], axis=1)
+        return np.where(np.concatenate([ok, ok], axis=1), r, np.nan)
 
     grid = np.arange(-LATENCY_MAX_S, LATENCY_MAX_S + 1e-9, LATENCY_STEP_S)
-    R = np.array([resid(L) for L in grid])
+    R = resid(grid)
     usable = np.all(np.isfinite(R), axis=0)
     if usable.sum() < 10:
         return None

@@ -202,6 +202,11 @@ class TruthMode:
         self.j = self.i + W
         self.trucks = robot.n_trucks
         self.tinc = [_body_inc(self.tpose[:, t], self.i, self.j) for t in range(self.trucks)]
+        # the windows' end samples: the residuals need the model there only (np.interp is
+        # pointwise, so interpolating at these alone gives the same numbers, W times cheaper)
+        self._ends = np.union1d(self.i, self.j)
+        self._ie = np.searchsorted(self._ends, self.i)
+        self._je = np.searchsorted(self._ends, self.j)
         # where the model's ticks fall among the truth samples
         self.exact = self.tt.size <= pr.t.size and np.allclose(
             np.interp(self.tt, pr.t, pr.t), self.tt, atol=1e-6
@@ -291,8 +296,11 @@ class TruthMode:
 
     def residuals(self, P: dict) -> np.ndarray:
         cols = []
+        te = self.tt[self._ends]
         for t in range(self.trucks):
-            m = _body_inc(self.model_pose(P, t), self.i, self.j)
+            p = dead_reckon(self.pr, P, t)
+            mp = np.column_stack([np.interp(te, self.pr.t, p[:, k]) for k in range(3)])
+            m = _body_inc(mp, self._ie, self._je)
             cols.append(self.tinc[t] - m)
         if self.has_link:
             tl = self.tlink[self.i]
@@ -529,20 +537,33 @@ class LinkageMode:
         the clapper/set false alarm. Costs one parameter per reading per window (see
         `nuisance_per_window`)."""
         J = self.J
-        w = 1.0 / self.floor
-        Jw = J * w[None, :, None]
+        w, Jw, half, A, Adiag = self._profile_terms()
         rw = r * w[None, :]
-        half = 0.5 * np.array(self.steps[: J.shape[2]])
-        A = np.einsum("nci,ncj->nij", Jw, Jw)
-        A = A + (1e-9 * np.trace(A, axis1=1, axis2=2) + 1e-9)[:, None, None] * np.eye(A.shape[1])
         g = -np.einsum("nci,nc->ni", Jw, rw)
         d = np.clip(np.linalg.solve(A, g[..., None])[..., 0], -half, half)
         for _ in range(2):  # coordinate passes for the box (the clipped Newton step is close)
             for k in range(J.shape[2]):
                 rest = rw + np.einsum("nci,ni->nc", Jw, d) - Jw[:, :, k] * d[:, k : k + 1]
                 num = -np.einsum("nc,nc->n", Jw[:, :, k], rest)
-                d[:, k] = np.clip(num / np.maximum(A[:, k, k], 1e-30), -half[k], half[k])
+                d[:, k] = np.clip(num / Adiag[k], -half[k], half[k])
         return r + np.einsum("nci,ni->nc", J, d)
+
+    def _profile_terms(self) -> tuple:
+        """What `_profile` needs that no hypothesis changes (the start Jacobian's weighted form
+        and normal matrix), computed once per run instead of once per residual evaluation."""
+        got = self.__dict__.get("_pterms")
+        if got is None:
+            J = self.J
+            w = 1.0 / self.floor
+            Jw = J * w[None, :, None]
+            half = 0.5 * np.array(self.steps[: J.shape[2]])
+            A = np.einsum("nci,ncj->nij", Jw, Jw)
+            A = A + (1e-9 * np.trace(A, axis1=1, axis2=2) + 1e-9)[:, None, None] * np.eye(
+                A.shape[1]
+            )
+            Adiag = [np.maximum(A[:, k, k], 1e-30) for k in range(J.shape[2])]
+            got = self._pterms = (w, Jw, half, A, Adiag)
+        return got
 
     def channels(self) -> list[str]:
         return (

@@ -437,7 +437,8 @@ def simulate_case(case: dict, real: Path, seed: int, progress=None) -> dict:
         raise
     events = []
     for e in sim["events"]:
-        e = dict(e)
+        # plain Python values: the events go into the key, a JSON file (numpy ints are not JSON)
+        e = {k: v.item() if isinstance(v, np.generic) else v for k, v in e.items()}
         r = e.pop("run_index")
         e["run"] = case["plan"][r]["name"]
         e["t_run_s"] = e["t_s"]  # since the run's start
