@@ -128,9 +128,7 @@ def test_sessions_of_different_robots_are_refused(sessions, tmp_path: Path) -> N
     robot = json.loads((other / "robot.json").read_text())
     robot["trucks"]["A"]["wheelbase_mm"] = 400
     (other / "robot.json").write_text(json.dumps(robot))
-    _fails(
-        tmp_path, "--real", str(sq), str(other), expect=("runs of different robots", "trucks")
-    )
+    _fails(tmp_path, "--real", str(sq), str(other), expect=("runs of different robots", "trucks"))
 
 
 def test_a_recording_states_its_return_accuracy(sessions, tmp_path: Path) -> None:
@@ -147,3 +145,29 @@ def test_a_recording_states_its_return_accuracy(sessions, tmp_path: Path) -> Non
 
     with pytest.raises(GapInputError, match="positive"):
         recorded_accuracy([d])
+
+
+def test_split_judges_every_kind_of_motion() -> None:
+    """UMBmark squares driven three times each way (spot turns) and a circle and a figure eight
+    driven once each (arcs): the old split held out half of each square path and never judged
+    an arc, so an effect only arcs show (scrub changes no spot turn; the independent world's
+    seed 7 case 22) could not be seen on a held-out run. Now one arc path is held out whole; the
+    squares' split is what it was, a kind driven once stays fitted, and every kind keeps a
+    fitting run."""
+    from odo_tools.gap.select import stratified
+
+    keys = ["cw:1"] * 3 + ["ccw:1"] * 3 + ["cw:2", "ccw:2", "cw:3"]
+    kinds = ["spot"] * 6 + ["arc", "arc", "straight"]
+    for seed in range(20):
+        old = stratified(keys, 0.5, seed)
+        new = stratified(keys, 0.5, seed, kinds)
+        assert not {6, 7} & set(old.held)
+        assert len({6, 7} & set(new.held)) == 1
+        assert set(new.held) - {6, 7} == set(old.held)
+        assert 8 in new.fit and 8 not in new.held
+        for kind in ("spot", "arc"):
+            assert any(kinds[i] == kind for i in new.fit)
+    # arcs already judged on a path driven twice: nothing more is held out
+    keys2 = [*keys[:6], "cw:2", "cw:2", "ccw:2"]
+    sel = stratified(keys2, 0.5, 1, [*kinds[:6], "arc", "arc", "arc"])
+    assert 8 not in sel.held and len({6, 7} & set(sel.held)) == 1

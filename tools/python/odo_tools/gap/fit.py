@@ -165,6 +165,28 @@ def _mad(x: np.ndarray) -> float:
     return float(1.4826 * np.median(np.abs(x - np.median(x))))
 
 
+RETURNS_FLOOR = np.array([0.5, 0.5, 1e-4])  # mm, mm, rad: a spread never taken below this
+
+
+def returns_spread(items: list) -> tuple[np.ndarray, float]:
+    """(sigma of x, y (mm) and heading (rad), its degrees of freedom): the spread of the return
+    poses of runs of one path about their path's mean, the non-systematic part (000 s. 3.3);
+    x and y share one sigma (placement, tape and the floor's walk move the end point in any
+    direction). Runs of the same path: same direction and the same travel (UMBmark squares and
+    rectangles differ systematically; grouping them by direction only made that "noise"). Paths
+    driven once say nothing. The degrees of freedom, m = sum over paths of (runs - 1) per
+    channel, pooled 2m for the position and m for the heading, give 1.5 m for the mean z^2 of
+    the three (verdict.py reads the gap threshold from F(n, dof))."""
+    r = np.vstack([it.residuals({}) for it in items])
+    dirs = np.array([group_key(it.pr) for it in items])
+    dev = np.vstack([r[dirs == d] - r[dirs == d].mean(axis=0) for d in np.unique(dirs)])
+    m = r.shape[0] - np.unique(dirs).size
+    ss = np.sum(dev**2, axis=0)
+    pos = math.sqrt((ss[0] + ss[1]) / max(1, 2 * m))
+    s = np.array([pos, pos, math.sqrt(ss[2] / max(1, m))])
+    return np.maximum(s, RETURNS_FLOOR), 1.5 * m
+
+
 def estimate_sigma(items: list, mode: str) -> np.ndarray:
     """Per-channel noise of the nominal model's residuals (see module doc)."""
     if mode == "returns" and items[0].accuracy is not None:
@@ -173,14 +195,7 @@ def estimate_sigma(items: list, mode: str) -> np.ndarray:
     r = np.vstack([it.residuals({}) for it in items])
     floor = np.array([2e-5 if ch.endswith("_rad") else 0.02 for ch in items[0].channels()])
     if mode == "returns":
-        # no repeated-measurement floor exists: the spread of the runs around their direction's
-        # mean is the non-systematic part (000 s. 3.3); a floor keeps it from vanishing
-        # runs of the same path: same direction and the same travel (UMBmark squares and
-        # rectangles differ systematically; grouping them by direction only made that "noise")
-        dirs = np.array([group_key(it.pr) for it in items])
-        dev = np.vstack([r[dirs == d] - r[dirs == d].mean(axis=0) for d in np.unique(dirs)])
-        s = np.sqrt(np.sum(dev**2, axis=0) / max(1, r.shape[0] - np.unique(dirs).size))
-        return np.maximum(s, np.array([0.5, 0.5, 1e-4]))
+        return returns_spread(items)[0]
     if mode == "truth":
         for c, ch in enumerate(items[0].channels()):
             if ch in ("alpha_rad", "beta_rad", "l_mm"):

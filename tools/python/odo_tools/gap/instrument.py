@@ -44,11 +44,24 @@ def estimate(prs: list[Prepared], trucks: int) -> tuple[Instrument, list[str]]:
     """(instrument, notes for the report) from the runs that have a truth track. The latency
     and the lever arm are estimated in turn, twice: each blurs the other (the independent
     world's 25 mm marker left its 27 ms latency within the 10 % a shift must gain)."""
-    inst = Instrument(lever_mm=[(0.0, 0.0)] * trucks, lever_se_mm=[(0.0, 0.0)] * trucks)
+    inst = Instrument(
+        lever_mm=[(0.0, 0.0)] * trucks,
+        lever_se_mm=[(0.0, 0.0)] * trucks,
+        heading_offset_rad=[0.0] * trucks,
+    )
     with_truth = [pr for pr in prs if pr.run.truth is not None]
+    for t in range(trucks):
+        o, se, n = heading_offset(with_truth, t)
+        if o is not None and abs(o) >= HEADING_OFFSET_SIGNIFICANT * se:
+            inst.heading_offset_rad[t] = o
     for _ in range(2):
         notes = []
-        found = {pr.run.name: latency(pr, lever=inst.lever_mm[0]) for pr in with_truth}
+        found = {
+            pr.run.name: latency(
+                pr, lever=inst.lever_mm[0], heading_offset=inst.heading_offset_rad[0]
+            )
+            for pr in with_truth
+        }
         inst.latency_s.update(session_latencies(with_truth, found))
         for t in range(trucks):
             o, se, n = lever_arm(with_truth, t, inst)
@@ -63,15 +76,115 @@ def estimate(prs: list[Prepared], trucks: int) -> tuple[Instrument, list[str]]:
     return inst, notes
 
 
+HEADING_OFFSET_SIGNIFICANT = 3.0  # |offset| in standard errors below which it is left at zero
+STRAIGHT_RAD = 0.02  # a stretch whose heading stays within this band (counts, nominal) ...
+STRAIGHT_MIN_MM = 100.0  # ... over at least this much travel is a straight (heading offset)
+STRAIGHT_EDGE_S = 0.1  # trimmed off a straight's ends
+HEADING_MIN_STRAIGHTS = 4
+
+
+def _straights(pr: Prepared, truck: int) -> list[tuple[float, float]]:
+    """(t0, t1) of the stretches the wheel counts say are straight: both wheels rolling one way,
+    the nominal heading staying within a band of STRAIGHT_RAD (a controller weaves about a
+    straight: the chord still follows the mean heading), at least STRAIGHT_MIN_MM long;
+    STRAIGHT_EDGE_S trimmed off both ends (the truth's latency)."""
+    ds = pr.ds[:, truck, :]
+    b = pr.b[truck]
+    dth = (ds[:, 1] - ds[:, 0]) / b
+    step = 0.5 * (ds[:, 0] + ds[:, 1])
+    ok = ds[:, 0] * ds[:, 1] > 0
+    out = []
+    k = 0
+    n = ok.size
+    while k < n:
+        if not ok[k]:
+            k += 1
+            continue
+        e = k
+        th, lo, hi, L = 0.0, 0.0, 0.0, 0.0
+        while e < n and ok[e] and np.sign(step[e]) == np.sign(step[k]):
+            th += dth[e]
+            lo, hi = min(lo, th), max(hi, th)
+            if hi - lo > STRAIGHT_RAD:
+                break
+            L += abs(step[e])
+            e += 1
+        t0, t1 = pr.t[k] + STRAIGHT_EDGE_S, pr.t[e] - STRAIGHT_EDGE_S
+        if L >= STRAIGHT_MIN_MM and t1 > t0:
+            out.append((float(t0), float(t1)))
+        k = max(e, k + 1)
+    return out
+
+
+def heading_offset(prs: list[Prepared], truck: int) -> tuple[float | None, float, int]:
+    """The marker body's heading against the truck's, from the truth's chords: on a straight the
+    truck moves along its heading, so over each stretch the wheel counts say is straight
+    (`_straights`: the counts are precise where a noisy truth heading is not) the mean of the
+    measured headings less the chord's direction is the offset (reversing: the chord turned by
+    pi). A lever arm does not move a chord while the heading holds, and a latency moves
+    neither. (offset rad, its standard error, stretches); None with fewer than
+    HEADING_MIN_STRAIGHTS stretches. The independent world's rig heading offset of up to 0.3 deg,
+    left in, turned every window's increment off the body axes (a 1.4 mm lateral misfit per
+    window on a LabMate's squares) and rotated the anchored model track, 20 mm over a leg: the
+    fits took it for skid or scrub and made held-out runs worse."""
+    vals, var = [], []
+    for pr in prs:
+        tr = pr.run.truth
+        if truck >= tr.pose.shape[1]:
+            continue
+        p = tr.pose[:, truck]
+        th = np.unwrap(p[:, 2])
+        # the truck's travel at each truth sample (counts): the chord of an arc lies along the
+        # heading's mean over distance, not over time (a robot speeding up along a stretch that
+        # an Ed bends gave the simulator's clapper a 0.05-0.13 deg offset it does not have)
+        s_c = np.interp(tr.t_s, pr.t, np.abs(pr.S[:, truck, :]).mean(axis=1))
+        for t0, t1 in _straights(pr, truck):
+            k = np.flatnonzero((tr.t_s >= t0) & (tr.t_s <= t1))
+            if k.size < 3:
+                continue
+            dx, dy = p[k[-1], 0] - p[k[0], 0], p[k[-1], 1] - p[k[0], 1]
+            L = math.hypot(dx, dy)
+            ds = np.abs(np.diff(s_c[k]))
+            if L < STRAIGHT_MIN_MM or not ds.sum() > 0:
+                continue
+            mean_th = float(np.sum(0.5 * (th[k][1:] + th[k][:-1]) * ds) / ds.sum())
+            o = math.remainder(mean_th - math.atan2(dy, dx), 2 * math.pi)
+            if abs(o) > 0.5 * math.pi:  # reversing
+                o = math.remainder(o - math.pi, 2 * math.pi)
+            vals.append(o)
+            var.append((float(np.var(np.diff(th[k]))) / 2.0) / k.size + 1.0 / L**2)
+    if len(vals) < HEADING_MIN_STRAIGHTS:
+        return None, 0.0, len(vals)
+    o, v = np.array(vals), np.array(var)
+    # each stretch's own noise gives a relative weight; the spread about the mean sets the scale
+    # (a controller that weaves along a straight moves the chord too)
+    w = 1.0 / v
+    med = float(np.median(o))
+    keep = np.abs(o - med) <= 4.0 * max(_mad(o), 1e-9)  # a bump's jolt: not the rig
+    o, w = o[keep], w[keep]
+    m = float(np.average(o, weights=w))
+    chi = float(np.sum(w * (o - m) ** 2) / max(o.size - 1, 1))
+    se = float(math.sqrt(chi / np.sum(w)))
+    return m, se, int(o.size)
+
+
 def under(inst: Instrument, prs: list[Prepared], P: dict) -> Instrument:
     """The instrument with each run's latency estimated again under a candidate P, without the
     half-tick floor: once the candidate takes its own share of the heading misfit where the rate
     changes (slip does; a kinematic effect does not), what is left of a shift is the clock. The
     OptiOdom squares' ~25 ms, half their 50 ms tick, read as the truth's noise otherwise."""
-    out = Instrument(list(inst.lever_mm), list(inst.lever_se_mm), dict(inst.latency_s))
+    out = inst.copy()
     with_truth = [pr for pr in prs if pr.run.truth is not None]
     found = {
-        pr.run.name: latency(pr, 0, P, min_tick=0.0, lever=inst.lever_mm[0]) for pr in with_truth
+        pr.run.name: latency(
+            pr,
+            0,
+            P,
+            min_tick=0.0,
+            lever=inst.lever_mm[0],
+            heading_offset=inst.heading_offset_rad[0],
+        )
+        for pr in with_truth
     }
     out.latency_s.update(session_latencies(with_truth, found))
     return out
@@ -111,6 +224,7 @@ def latency(
     P: dict | None = None,
     min_tick: float = 0.0,
     lever: tuple[float, float] = (0.0, 0.0),
+    heading_offset: float = 0.0,
 ) -> float | None:
     """The shift (s) that best lines the truth's heading (times half the wheelbase) and travel
     increments over 0.4 s windows up with the model's (P, nominal by default); None when no
@@ -124,7 +238,7 @@ def latency(
     i, j = _windows(tt)
     if i.size < 10:
         return None
-    tp = to_centre(tr.pose[:, truck : truck + 1], [lever])[:, 0]
+    tp = to_centre(tr.pose[:, truck : truck + 1], [lever], [heading_offset])[:, 0]
     half_b = 0.5 * pr.b[truck]
     dth = tp[j, 2] - tp[i, 2]
     c, s_ = np.cos(tp[i, 2]), np.sin(tp[i, 2])
@@ -229,7 +343,8 @@ def lever_arm(
             continue
         p = dead_reckon(pr, P or {}, truck)
         m = np.column_stack([np.interp(tt, pr.t, p[:, k]) for k in range(3)])
-        inc_t = _body_inc(tr.pose[:, truck], i, j)
+        off = inst.heading_offset_rad[truck] if truck < len(inst.heading_offset_rad) else 0.0
+        inc_t = _body_inc(to_centre(tr.pose[:, truck : truck + 1], [(0.0, 0.0)], [off])[:, 0], i, j)
         inc_m = _body_inc(m, i, j)
         dth = inc_t[:, 2]
         travel = np.hypot(inc_m[:, 0], inc_m[:, 1])

@@ -85,15 +85,21 @@ def _censored(x: np.ndarray, code: np.ndarray, step: float, angle: bool) -> np.n
     return np.clip(d, -tol, step + tol) - d
 
 
-def to_centre(pose: np.ndarray, lever_mm: list[tuple[float, float]]) -> np.ndarray:
-    """Tracked-point poses (n, trucks, 3) -> axle-centre poses: subtract the lever arm (x forward,
-    y left, mm) rotated by the measured heading."""
+def to_centre(
+    pose: np.ndarray, lever_mm: list[tuple[float, float]], heading_offset_rad=None
+) -> np.ndarray:
+    """Tracked-point poses (n, trucks, 3) -> axle-centre poses: take the marker body's heading
+    offset off the measured heading, then subtract the lever arm (x forward, y left, mm) rotated
+    by that heading."""
     out = pose.copy()
+    for t, o in enumerate(heading_offset_rad or []):
+        if t < pose.shape[1] and o:
+            out[:, t, 2] -= o
     for t in range(pose.shape[1]):
         ox, oy = lever_mm[t] if t < len(lever_mm) else (0.0, 0.0)
         if ox == 0.0 and oy == 0.0:
             continue
-        c, s_ = np.cos(pose[:, t, 2]), np.sin(pose[:, t, 2])
+        c, s_ = np.cos(out[:, t, 2]), np.sin(out[:, t, 2])
         out[:, t, 0] -= c * ox - s_ * oy
         out[:, t, 1] -= s_ * ox + c * oy
     return out
@@ -157,6 +163,14 @@ class Instrument:
     lever_mm: list[tuple[float, float]] = field(default_factory=lambda: [(0.0, 0.0)] * 2)
     lever_se_mm: list[tuple[float, float]] = field(default_factory=lambda: [(0.0, 0.0)] * 2)
     latency_s: dict[str, float] = field(default_factory=dict)
+    # per truck: the marker body's heading against the truck's (rad; measured = true + offset)
+    heading_offset_rad: list[float] = field(default_factory=lambda: [0.0, 0.0])
+
+    def copy(self) -> Instrument:
+        return Instrument(
+            list(self.lever_mm), list(self.lever_se_mm), dict(self.latency_s),
+            list(self.heading_offset_rad),
+        )  # fmt: skip
 
 
 class TruthMode:
@@ -175,7 +189,7 @@ class TruthMode:
         if sel.sum() < 10:
             raise ValueError(f"{pr.run.name}: fewer than 10 truth samples overlap the log")
         self.tt = t_true[sel]
-        self.tpose = to_centre(tr.pose[sel], inst.lever_mm)
+        self.tpose = to_centre(tr.pose[sel], inst.lever_mm, inst.heading_offset_rad)
         # the true linkage from the two trucks' (centre) poses, with the same lever arms and
         # latency as the trucks: a linkage column the motion capture derived from its markers
         # carries their lever arms as offsets a rotary or link-length bias would take up (the

@@ -69,6 +69,15 @@ def turn_style(pr: Prepared) -> tuple[float, float]:
     return float(dth[spot].sum()), float(dth[arc].sum())
 
 
+def motion_kind(pr: Prepared) -> str:
+    """How a run turns, in one word: 'spot' (most of its turning on the spot), 'arc' or
+    'straight' (barely turns). The held-out split covers every kind the fit sees (select.py)."""
+    spot, arc = turn_style(pr)
+    if spot + arc < 0.3:
+        return "straight"
+    return "spot" if spot >= SPOT_SHARE * (spot + arc) else "arc"
+
+
 def describe_shape(pr: Prepared) -> str:
     """A short name for a run's path: its length and how it turns ('3.0 m, spot turns')."""
     spot, arc = turn_style(pr)

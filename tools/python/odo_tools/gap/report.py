@@ -165,6 +165,9 @@ class Report:
                     list(x) for x in ds.instrument.lever_se_mm[: ds.robot.n_trucks]
                 ],
                 "latency_s": dict(ds.instrument.latency_s),
+                "heading_offset_deg": [
+                    math.degrees(x) for x in ds.instrument.heading_offset_rad[: ds.robot.n_trucks]
+                ],
                 "notes": list(ds.notes),
             }
         bg = jd.background

@@ -25,23 +25,53 @@ class Selection:
         return set(self.fit) == set(self.held)
 
 
-def stratified(keys: list[str], frac: float, seed: int) -> Selection:
-    """Held-out runs, stratified by `keys` (the path each run drove): each group keeps at least
-    one fitting run; frac of each group, at least one, is held out."""
+def stratified(
+    keys: list[str], frac: float, seed: int, kinds: list[str] | None = None
+) -> Selection:
+    """Held-out runs, stratified by `keys` (the path each run drove): each path keeps at least
+    one fitting run; frac of each path driven more than once, at least one, is held out.
+
+    `kinds` (paths.motion_kind: spot turns, arcs, straights): a kind of motion whose runs all
+    drove paths of their own (a circle and a figure eight, driven once each) would otherwise
+    never be judged, and an effect only that motion shows (scrub changes no spot turn) could
+    never be seen on the held-out runs. Where the split leaves a kind without a held-out run,
+    frac of its single-run paths (at least one) is held out whole, as long as the kind keeps a
+    fitting run: judged on a path the fit never saw (no floor bumps are placed there)."""
     rng = np.random.default_rng(seed)
     fit, held = [], []
+    singles = []
     for d in sorted(set(keys)):
         idx = [i for i, k in enumerate(keys) if k == d]
+        if len(idx) == 1:
+            singles.append(idx[0])
+            continue
         nh = min(len(idx) - 1, max(1, int(frac * len(idx)))) if frac > 0 else 0
         perm = [int(x) for x in rng.permutation(idx)]
         held += perm[:nh]
         fit += perm[nh:]
+    whole = 0
+    if kinds is not None and frac > 0:
+        rk = np.random.default_rng([seed, 1])  # the paths' split above stays as it was
+        for kind in sorted({kinds[i] for i in singles}):
+            if any(kinds[i] == kind for i in held):
+                continue
+            own = [i for i in singles if kinds[i] == kind]
+            fitted = sum(1 for i in fit if kinds[i] == kind) + len(own)
+            nh = min(fitted - 1, len(own), max(1, int(frac * len(own))))
+            if nh <= 0:
+                continue
+            perm = [int(x) for x in rk.permutation(own)]
+            held += perm[:nh]
+            singles = [i for i in singles if i not in perm[:nh]]
+            whole += nh
+    fit += singles
     fit, held = sorted(fit), sorted(held)
     if not held:
         return Selection(tuple(fit), tuple(fit), "no run could be held out: judged in-sample")
-    return Selection(
-        tuple(fit), tuple(held), f"random split, {frac:.0%} of each path held out (seed {seed})"
-    )
+    how = f"random split, {frac:.0%} of each path held out (seed {seed})"
+    if whole:
+        how += f"; {whole} path(s) driven once held out whole, so every kind of motion is judged"
+    return Selection(tuple(fit), tuple(held), how)
 
 
 def _matches(run: RunData, groups: dict[str, str], pattern: str) -> bool:

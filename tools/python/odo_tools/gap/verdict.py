@@ -4,6 +4,8 @@ but background). Stated once here; report.json repeats the thresholds it used.""
 
 from __future__ import annotations
 
+import math
+
 from .fit import DBIC_SIGNIFICANT
 from .heldout import HeldOut
 
@@ -15,12 +17,39 @@ R_WITHIN = 1.5  # after the fit, within 1.5 x the background: the effect is name
 EXCESS_REMOVED = 0.75  # ... or it removes this share of the held-out misfit above background
 
 
+GAP_QUANTILE = 0.99  # a background estimated from few runs: R^2 beyond F(n, dof)'s 99 %
+
+
+def r_gap(held: HeldOut) -> float:
+    """The nominal misfit that makes a gap. Where the background is itself estimated from a
+    handful of values (returns without a stated accuracy: the spread of 2-3 runs per path,
+    `noise_dof` degrees of freedom), the held-out R^2 of a robot with nothing but background
+    follows F(n held-out values, dof), whose 99 % point lies far above 4 for a few dof (F(6, 3):
+    28): the gap needs R beyond sqrt of that."""
+    dof = held.extra.get("noise_dof")
+    if dof is None:
+        return R_GAP
+    n = sum(g.n for g in held.before)
+    if dof <= 0:
+        return math.inf
+    from scipy.stats import f as fdist
+
+    return max(R_GAP, math.sqrt(float(fdist.ppf(GAP_QUANTILE, n, dof))))
+
+
 def decide(held: HeldOut, dbic: float, label: str) -> tuple[str, str]:
     """The verdict from the held-out misfit ratios R (heldout.py) in words."""
     r0, r1 = held.ratio_before, held.ratio_after
     excess0, excess1 = r0 * r0 - 1.0, r1 * r1 - 1.0
     removed = 1.0 - excess1 / excess0 if excess0 > 0 else 0.0
-    if not (r0 >= R_GAP or (dbic >= DBIC_SIGNIFICANT and r0 >= R_GAP_WITH_BIC)):
+    rg = r_gap(held)
+    if not (r0 >= rg or (dbic >= DBIC_SIGNIFICANT and r0 >= max(R_GAP_WITH_BIC, rg))):
+        if rg > R_GAP:
+            return "no significant gap", (
+                f"the nominal model's held-out misfit is {r0:.2f} x the background, which is "
+                f"itself the spread of few runs ({held.extra['noise_dof']:g} degrees of freedom):"
+                f" a gap needs {rg:.2f} x (the {GAP_QUANTILE:.0%} point of F)"
+            )
         return "no significant gap", (
             f"the nominal model's held-out misfit is {r0:.2f} x the background (a gap needs "
             f"{R_GAP:g} x, or {R_GAP_WITH_BIC:g} x with Delta BIC >= {DBIC_SIGNIFICANT:g} on the "
@@ -44,4 +73,5 @@ THRESHOLDS = {
     "heldout_ratio_gap_with_bic": R_GAP_WITH_BIC,
     "heldout_ratio_named": R_WITHIN,
     "heldout_excess_removed_named": EXCESS_REMOVED,
+    "heldout_gap_quantile_few_dof": GAP_QUANTILE,
 }
