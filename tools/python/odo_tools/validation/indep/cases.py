@@ -245,8 +245,9 @@ def _fit(segs: list, lim: paths.Limits, max_s: float, rmin: float) -> list:
 
 
 def draw_plan(rng: np.random.Generator, case: dict, effects: list[str]) -> list[dict]:
-    """6-12 runs of several shapes; UMBmark squares in both directions always among them. A
-    run lasts at most max(30 s, 2500 control cycles) and 50 s."""
+    """6-13 runs of several shapes; UMBmark squares in both directions always among them (a
+    case with count loss drives its sprint twice). A run lasts at most max(30 s, 2500 control
+    cycles) and 50 s."""
     rob = case["robot"]
     veh = rob["vehicle"]
     b = rob["trucks"]["A"]["wheelbase_mm"]
@@ -321,6 +322,12 @@ def draw_plan(rng: np.random.Generator, case: dict, effects: list[str]) -> list[
         p["segs"] = _fit(p["segs"], limits(case, p), max_s, rmin)
     order = rng.permutation(len(plan))
     plan = [plan[i] for i in order]
+    if "count_loss" in effects:
+        # the sprint is driven twice, like every path a diagnosis is to fit on one run and judge
+        # on another: the only path fast enough to lose counts, driven once, was either fitted
+        # or judged. Inserted after the draws, so every other run of every case is as before.
+        i = next(i for i, p in enumerate(plan) if p["shape"] == "sprint")
+        plan.insert(i + 1, {**plan[i], "segs": list(plan[i]["segs"])})
     counts: dict[str, int] = {}
     for p in plan:
         counts[p["label"]] = counts.get(p["label"], 0) + 1
