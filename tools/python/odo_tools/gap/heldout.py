@@ -102,6 +102,32 @@ class HeldOut:
         return float(np.mean(self.background_deg))
 
 
+def track_error(
+    item: TruthMode, P: dict, sigma: np.ndarray, bg: Background, t: int
+) -> tuple[np.ndarray, np.ndarray]:
+    """(error, variance), each (windows, 3): truck t's accumulated x, y, heading error under P
+    at every window start of a truth run (the model anchored where the truth starts), and the
+    variance the truth's noise and the measured background alone give it there."""
+    m = item.anchored(P, t)[item.i]
+    e = m - item.tpose[item.i, t]
+    e[:, 2] = wrap_rad(e[:, 2])
+    s_pos = sigma[3 * t] / math.sqrt(2.0)
+    s_head = sigma[3 * t + 2] / math.sqrt(2.0)
+    tv = bg.track_var(item, t)
+    var = np.column_stack([s_pos**2 + tv[:, 0], s_pos**2 + tv[:, 1], s_head**2 + tv[:, 2]])
+    return e, var
+
+
+def track_z(item: TruthMode, P: dict, sigma: np.ndarray, bg: Background) -> np.ndarray:
+    """The standardised accumulated errors of every truck of a truth run under P (the values
+    whose mean square is R^2), flat; the linkage readings are not among them."""
+    zs = []
+    for t in range(item.trucks):
+        e, var = track_error(item, P, sigma, bg, t)
+        zs.append((e / np.sqrt(var)).ravel())
+    return np.concatenate(zs)
+
+
 def run_gap(item, P: dict, sigma: np.ndarray, bg: Background) -> tuple[RunGap, float, float]:
     """(gap of one run under P, background allowance in mm and deg)."""
     name = item.pr.run.name
@@ -109,13 +135,7 @@ def run_gap(item, P: dict, sigma: np.ndarray, bg: Background) -> tuple[RunGap, f
         zs, mm, deg = [], 0.0, 0.0
         bmm, bdeg = 0.0, 0.0
         for t in range(item.trucks):
-            m = item.anchored(P, t)[item.i]
-            e = m - item.tpose[item.i, t]
-            e[:, 2] = wrap_rad(e[:, 2])
-            s_pos = sigma[3 * t] / math.sqrt(2.0)
-            s_head = sigma[3 * t + 2] / math.sqrt(2.0)
-            tv = bg.track_var(item, t)
-            var = np.column_stack([s_pos**2 + tv[:, 0], s_pos**2 + tv[:, 1], s_head**2 + tv[:, 2]])
+            e, var = track_error(item, P, sigma, bg, t)
             zs.append(e / np.sqrt(var))
             if t == 0:
                 mm = float(np.sqrt(np.mean(e[:, 0] ** 2 + e[:, 1] ** 2)))
