@@ -81,3 +81,20 @@ def test_a_diagnosing_process_cannot_open_a_key(tmp_path: Path) -> None:
     r = subprocess.run([PY, "-c", code], env=env(), capture_output=True, text=True, timeout=60)
     assert r.returncode != 0
     assert "recorded" in r.stdout and "may not open" in r.stderr
+
+
+def test_roughness_counts_in_returns_mode_only_where_the_recording_states_its_accuracy(
+    blind: Path,
+) -> None:
+    """Without a stated return accuracy the returns' spread is the only noise and roughness is
+    no returns hypothesis (its mean is an Eb's alias): such a case is not scored there. Truth
+    mode scores it either way; the simulator's world states its accuracy (instrument.json)."""
+    from odo_tools.validation.blind import scored_in
+
+    c = {"kind": "single", "vehicle": "labmate", "effects": ["roughness"]}
+    assert not scored_in(c, "returns")
+    assert scored_in({**c, "accuracy_stated": True}, "returns")
+    assert scored_in(c, "truth") and scored_in({**c, "accuracy_stated": True}, "truth")
+    assert scored_in({**c, "effects": ["eb"]}, "returns")
+    keys = sorted((blind / "sim" / "keys").glob("case-*.json"))
+    assert keys and all(json.loads(k.read_text())["accuracy_stated"] for k in keys)

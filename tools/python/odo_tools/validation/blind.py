@@ -419,6 +419,7 @@ def run_blind(
                 real = data / w / f"case-{c['case']:03d}" / "real"
                 key = simulate(c, real, seed * 1000 + c["case"])
                 c.update(key or {})
+                c["accuracy_stated"] = (real / "instrument.json").is_file()
                 (tmp / w / "keys" / f"case-{c['case']:03d}.json").write_text(
                     json.dumps(c, indent=1, default=_jsonable)
                 )
@@ -518,10 +519,21 @@ def truth_label(c: dict) -> str:
     return "+".join(sorted(c["effects"]))
 
 
+# effects a mode identifies only when the recording states its measurement's accuracy: from
+# return errors alone (their spread the only noise) roughness's mean shortens every turn like an
+# Eb, its alias, and the diagnosis leaves it out of the hypotheses (diagnose.rank)
+NEEDS_STATED_ACCURACY = {"returns": {"roughness"}}
+
+
 def scored_in(c: dict, mode: str) -> bool:
     """A catalog case counts toward a mode's top-1 when the catalog says the mode identifies
-    every one of its effects on that vehicle (evidence `yes`)."""
+    every one of its effects on that vehicle (evidence `yes`), and, for the effects in
+    NEEDS_STATED_ACCURACY, when its recording stated the accuracy (`accuracy_stated`, set
+    when the case is generated; the simulator's world writes instrument.json, the independent
+    world does not)."""
     ok = set(catalog.identifiable(mode, c["vehicle"]))
+    if not c.get("accuracy_stated", False):
+        ok -= NEEDS_STATED_ACCURACY.get(mode, set())
     return c["kind"] in ("single", "pair") and all(e in ok for e in c["effects"])
 
 
