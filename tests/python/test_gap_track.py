@@ -80,3 +80,32 @@ def test_a_member_that_only_helps_the_runs_it_was_fitted_to_stays_out(tmp_path: 
     indep.simulate_case(c, real, 8 * 1000 + 6)
     v = D.diagnose(real, real / "robot.json").to_dict()["verdict"]
     assert v["effect"] == "scrub", v
+
+
+def test_a_linkage_bias_below_half_an_encoder_step_is_no_member() -> None:
+    """diagnose._below_resolution: a 0.07 deg rotary bias on an 11-bit encoder (0.18 deg steps)
+    is what a truth's lever arm a few mm off fakes; 0.3 deg is a bias. The linear encoder alike."""
+    from odo_tools.gap import hypotheses as H
+    from odo_tools.gap.fit import Fit
+    from odo_tools.gap.io import Robot
+
+    set_ = Robot("r.json", "set", 0.04, [{}, {}], trailer={"rotary_bits": 11})
+    clap = Robot(
+        "r.json", "clapper", 0.04, [{}, {}],
+        linkage={"rotary_bits": 10, "linear_resolution_mm": 0.1},
+    )
+
+    def fit(fams: tuple[str, ...], params: dict, vehicle: str) -> Fit:
+        hyp = H.Hypothesis(tuple(H.catalog_law(f, vehicle) for f in fams))
+        return Fit("+".join(fams), params, {}, 0.0, 0.0, 100, len(params), [], hyp)
+
+    small = fit(("count_loss", "rotary_bias"), {"rotary_bias.alpha_deg": -0.07}, "set")
+    assert D._below_resolution(small, set_) == {"rotary_bias"}
+    big = fit(("rotary_bias",), {"rotary_bias.alpha_deg": 0.3}, "set")
+    assert not D._below_resolution(big, set_)
+    both = {"rotary_bias.alpha_deg": 0.1, "rotary_bias.beta_deg": 0.4}  # 10 bit: 0.35 deg steps
+    assert not D._below_resolution(fit(("rotary_bias",), both, "clapper"), clap)
+    link = {"link_bias.const_mm": 0.02, "link_bias.ecc_mm": -0.01}
+    assert D._below_resolution(fit(("link_bias",), link, "clapper"), clap) == {"link_bias"}
+    link["link_bias.const_mm"] = 0.5
+    assert not D._below_resolution(fit(("link_bias",), link, "clapper"), clap)
