@@ -165,3 +165,43 @@ def test_roughness_window_share_matches_a_direct_count() -> None:
         # one height: hmax tiny band around h via n=1 (midpoint of [0, hmax] = h)
         _, _, q = rough_window_var(R, 2 * h, np.array([L]), n=1)
         assert q[0] == pytest.approx(direct, rel=1e-3)
+
+
+def test_count_loss_at_a_rate_ceiling_recovers_the_hidden_speed() -> None:
+    """model.count_loss_plateau: a decoder that counts at most 600 mm/s of wheel travel while the
+    wheel runs up to 1000 mm/s at 2 m/s^2 and back; the counts' flat top is the ceiling
+    (plateau_level), and with the true excess and acceleration the hidden travel comes back
+    (to the tick where the wheel crosses the ceiling inside a tick). A slower run whose counts
+    never reach the ceiling is left as it is."""
+    from odo_tools.gap.model import Prepared, count_loss_plateau, plateau_level
+
+    dt, a, vmax, ceil = 0.02, 2000.0, 1000.0, 600.0
+    fine = np.arange(0.0, 2.0, 1e-4)
+    ramp = np.minimum(np.minimum(a * fine, a * (fine[-1] - fine)), vmax)
+    v = np.concatenate([np.zeros(2000), ramp, np.zeros(2000)])  # 1e-4 s samples
+    per = round(dt / 1e-4)
+    true = v.reshape(-1, per).sum(axis=1) * 1e-4  # mm per tick
+    counted = np.minimum(v, ceil).reshape(-1, per).sum(axis=1) * 1e-4
+
+    def prep(d: np.ndarray) -> Prepared:
+        ds = d[:, None, None] * np.ones((1, 1, 2))
+        n = d.size + 1
+        S = np.concatenate([np.zeros((1, 1, 2)), np.cumsum(np.abs(ds), axis=0)])
+        return Prepared(None, np.arange(n) * dt, ds, S, [400.0], [75.0], np.full(n - 1, dt))
+
+    pr, slow = prep(counted), prep(0.5 * counted)
+    assert plateau_level([pr, slow]) == pytest.approx(ceil, rel=1e-9)
+    P = {
+        "count_loss@plateau.level_mm_s": ceil,
+        "count_loss@plateau.excess_mm_s": vmax - ceil,
+        "count_loss@plateau.a_m_s2": a / 1000.0,
+    }
+    got = count_loss_plateau(pr, pr.ds[:, 0, :].copy(), 0, P)[:, 0]
+    assert true.sum() - counted.sum() > 200.0  # the counts lost 20 cm
+    assert abs(got.sum() - true.sum()) < 0.01 * (true.sum() - counted.sum())
+    assert np.abs(got - true).max() < 0.02 * vmax * dt  # tick by tick, edges included
+    assert np.array_equal(count_loss_plateau(slow, slow.ds[:, 0, :].copy(), 0, P), slow.ds[:, 0, :])
+    # a wrong acceleration predicts another travel: the test can tell them apart
+    P["count_loss@plateau.a_m_s2"] = 1.0
+    off = count_loss_plateau(pr, pr.ds[:, 0, :].copy(), 0, P)[:, 0]
+    assert abs(off.sum() - true.sum()) > 0.1 * (true.sum() - counted.sum())

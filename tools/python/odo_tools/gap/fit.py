@@ -343,6 +343,11 @@ def fit_hypothesis(
             fixed["roughness.max_height_mm"] = prob.rough_from_walk()
         elif "roughness.max_height_mm" not in keys:  # returns, linkage: no walk is measured,
             keys.append("roughness.max_height_mm")  # its height is fitted (its own spread)
+    if any(law.key.startswith("count_loss@plateau") for law in hyp.laws):
+        from .model import plateau_level  # the ceiling the counts show, not a free parameter
+
+        for t in range(len(prs[0].b)):
+            fixed[f"count_loss@plateau.level_mm_s.{'AB'[t]}"] = plateau_level(prs, t)
     if not hyp.has_bumps:
         P, se = fit_params(prob, keys, fixed, warm=warm, bnd=bnd)
         return evaluate(prob, hyp.name, P, se, len(keys), hyp=hyp)

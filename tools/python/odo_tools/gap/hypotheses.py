@@ -36,6 +36,8 @@ EXTRA_BOUNDS = {
     "slip@traction.a_max_m_s2": (0.05, 20.0, 2.0),
     "count_loss@speed.k_per_m_s": (0.0, 20.0, 0.2),
     "count_loss@speed.v0_mm_s": (0.0, 5000.0, 300.0),
+    "count_loss@plateau.excess_mm_s": (0.0, 5000.0, 400.0),
+    "count_loss@plateau.a_m_s2": (0.05, 20.0, 1.0),
 }
 START = {"slip.k_per_m_s2": 0.05, "skid.k_s": 0.05, "roughness.max_height_mm": 0.5}
 
@@ -91,6 +93,13 @@ OTHER_LAWS = {
             "speed",
             ("count_loss@speed.k_per_m_s", "count_loss@speed.v0_mm_s"),
             "a fraction k max(0, |v| - v0) of the travel never reaches the counter",
+        ),
+        Law(
+            "count_loss",
+            "plateau",
+            ("count_loss@plateau.excess_mm_s", "count_loss@plateau.a_m_s2"),
+            "a count-rate ceiling: the counts sit on a flat top while the hidden wheel speed "
+            "rises at a to the ceiling + excess and back",
         ),
     ),
 }

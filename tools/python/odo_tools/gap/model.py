@@ -201,6 +201,8 @@ def floor_travel(
         ds = slip_traction(pr, ds, P["slip@traction.a_max_m_s2"])
     if P.get("count_loss@speed.k_per_m_s", 0.0) > 0:
         ds = count_loss_speed(pr, ds, truck, P)
+    if P.get("count_loss@plateau.level_mm_s", 0.0) > 0:
+        ds = count_loss_plateau(pr, ds, truck, P)
     for ev in pr.bumps:
         if ev["truck"] != truck:
             continue
@@ -317,6 +319,50 @@ def count_loss_speed(pr: Prepared, ds: np.ndarray, truck: int, P: dict) -> np.nd
     v = np.abs(pr.ds[:, truck, :]) / pr.dt[:, None]
     lam = np.minimum(k * np.maximum(v - v0, 0.0) * 1e-3, 0.9)
     return ds / (1.0 - lam)
+
+
+PLATEAU_TOL = 0.003  # a tick within 0.3 % of the decoder's count-rate ceiling is saturated
+PLATEAU_SUB = 8  # sub-steps per tick of the hidden speed's integral
+
+
+def plateau_level(prs: list, truck: int = 0) -> float:
+    """The decoder's count-rate ceiling as the counts show it: the highest wheel speed (mm/s)
+    any run's counts reach. A rate-limited decoder counts exactly that while the wheel runs
+    faster; a decoder that never saturated makes it some cruise's top speed, where the law
+    below then fits no hidden speed."""
+    return max(float(np.max(np.abs(pr.ds[:, truck, :]) / pr.dt[:, None])) for pr in prs)
+
+
+def count_loss_plateau(pr: Prepared, ds: np.ndarray, truck: int, P: dict) -> np.ndarray:
+    """Counts lost at a hard rate limit: a decoder that takes at most so many edges per second
+    counts the ceiling `level` however fast the wheel runs, so its counts sit on a flat top
+    while the wheel's true speed, hidden, goes on rising at the drive's acceleration a to the
+    speed V it was commanded, holds and comes back down to the ceiling where the counts leave
+    the top. Per stretch of saturated ticks of a wheel, the travel beyond the counted is the
+    integral of min(a tau, a (T - tau), V - level) over the tick (tau from the stretch's start,
+    T its length). V - level (`excess_mm_s`) and a are the law's parameters; the ceiling comes
+    from the counts (`plateau_level`)."""
+    level = P["count_loss@plateau.level_mm_s"]
+    E = P.get("count_loss@plateau.excess_mm_s", 0.0)
+    a = P.get("count_loss@plateau.a_m_s2", 1.0) * 1e3
+    if E <= 0.0:
+        return ds
+    t = pr.t
+    raw = pr.ds[:, truck, :]
+    sat = np.abs(raw) / pr.dt[:, None] >= level * (1.0 - PLATEAU_TOL)
+    out = ds.copy()
+    f = (np.arange(PLATEAU_SUB) + 0.5) / PLATEAU_SUB
+    for w in (0, 1):
+        m = np.concatenate([[False], sat[:, w], [False]]).astype(np.int8)
+        starts = np.flatnonzero(np.diff(m) == 1)
+        ends = np.flatnonzero(np.diff(m) == -1)
+        for i0, i1 in zip(starts, ends, strict=True):
+            T = t[i1] - t[i0]
+            tau = t[i0:i1, None] - t[i0] + f[None, :] * pr.dt[i0:i1, None]
+            ex = np.minimum(np.minimum(a * tau, a * (T - tau)), E)
+            extra = ex.mean(axis=1) * pr.dt[i0:i1]
+            out[i0:i1, w] += np.sign(raw[i0:i1, w]) * extra
+    return out
 
 
 SLIP_SUB_S = 0.001  # sub-step of the slip integral (the catalog's law acts per physics step)
