@@ -197,3 +197,43 @@ def place_bumps(
 def clear_bumps(prs: list[Prepared]) -> None:
     for pr in prs:
         pr.bumps = []
+
+
+POSITION_TOL_MM = 40.0  # a held-out wheel passing this close to a floor bump's spot rolls over it
+
+
+def place_by_position(items: list, floor_bumps: list[dict], P: dict) -> int:
+    """Put floor bumps on truth runs by where they lie on the floor: a bump found on a fitting
+    run is a feature of the floor at (x_mm, y_mm), and a held-out run whose wheel - along its
+    own counts' track under P, started where its truth starts - passes within POSITION_TOL_MM of
+    that spot rolls over it there, whichever path it drives and whichever of its wheels it is.
+    Added to the bumps already placed (their path's rule, `place_bumps`), never twice at one
+    spot; returns how many were added. With one fitting run per path, a bump seen once was
+    never placed on a held-out run, and no bump case could close its held-out gap."""
+    added = 0
+    for it in items:
+        pr = it.pr
+        for truck in range(it.trucks):
+            pose = it.anchored(P, truck)
+            th = pose[:, 2]
+            for w in (0, 1):
+                half = (0.5 if w == 0 else -0.5) * pr.b[truck]
+                wx = pose[:, 0] - half * np.sin(th)
+                wy = pose[:, 1] + half * np.cos(th)
+                S = np.interp(it.tt, pr.t, pr.S[:, truck, w])
+                for b in floor_bumps:
+                    if b["truck"] != truck:
+                        continue
+                    d = np.hypot(wx - b["x_mm"], wy - b["y_mm"])
+                    k = int(np.argmin(d))
+                    if d[k] > POSITION_TOL_MM:
+                        continue
+                    s0 = float(S[k])
+                    if any(
+                        e["truck"] == truck and abs(e["s0"] - s0) < POSITION_TOL_MM
+                        for e in pr.bumps
+                    ):
+                        continue
+                    pr.bumps.append({"truck": truck, "wheel": w, "s0": s0, "h": b["h"]})
+                    added += 1
+    return added
