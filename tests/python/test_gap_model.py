@@ -206,27 +206,3 @@ def test_count_loss_at_a_rate_ceiling_recovers_the_hidden_speed() -> None:
     off = count_loss_plateau(pr, pr.ds[:, 0, :].copy(), 0, P)[:, 0]
     assert abs(off.sum() - true.sum()) > 0.1 * (true.sum() - counted.sum())
 
-
-def test_floor_bumps_go_where_a_held_out_wheel_rolls_over_their_spot() -> None:
-    """bumps.place_by_position: a straight run along x (wheelbase 400 mm, left wheel at y = +200)
-    meets a floor bump found at (500, 200) with its left wheel at 500 mm of travel; a bump 300 mm
-    to the side is not on its way; a bump already placed at that travel is not placed twice."""
-    from types import SimpleNamespace
-
-    from odo_tools.gap.bumps import place_by_position
-    from odo_tools.gap.model import Prepared
-
-    n = 101
-    t = np.arange(n) * 0.04
-    x = np.linspace(0.0, 1000.0, n)
-    ds = np.column_stack([np.diff(x), np.diff(x)])[:, None, :]
-    S = np.concatenate([np.zeros((1, 1, 2)), np.cumsum(np.abs(ds), axis=0)])
-    pr = Prepared(None, t, ds, S, [400.0], [75.0], np.full(n - 1, 0.04))
-    pose = np.column_stack([x, np.zeros(n), np.zeros(n)])
-    it = SimpleNamespace(pr=pr, trucks=1, tt=t, anchored=lambda P, truck: pose)
-    on_way = {"truck": 0, "wheel": 1, "x_mm": 500.0, "y_mm": 200.0, "h": 5.0}
-    aside = {"truck": 0, "wheel": 0, "x_mm": 700.0, "y_mm": 500.0, "h": 5.0}
-    assert place_by_position([it], [on_way, aside], {}) == 1
-    (b,) = pr.bumps
-    assert b["wheel"] == 0 and abs(b["s0"] - 500.0) <= 10.0 and b["h"] == 5.0  # the left wheel
-    assert place_by_position([it], [on_way], {}) == 0  # already there

@@ -667,9 +667,7 @@ def judge(ds: Dataset, sel: Selection, rk: Ranking) -> Judgement:
     pool = [items[i] for i in sel.held if i not in sel.fit] if ds.mode == "truth" else None
     bg = measure(fit_items, rk.prob.sigma, ds.mode, rk.best.model_params(), pool=pool)
     clear_bumps(fprs + hprs)
-    held = evaluate_heldout(
-        items, ds.prs, list(sel.held), rk.best, rk.prob.sigma, bg, by_position=True
-    )
+    held = evaluate_heldout(items, ds.prs, list(sel.held), rk.best, rk.prob.sigma, bg)
     if ds.noise_dof is not None:
         held.extra["noise_dof"] = ds.noise_dof
     dbic = rk.null.bic - rk.best.bic

@@ -22,7 +22,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .background import Background
-from .bumps import clear_bumps, place_bumps, place_by_position
+from .bumps import clear_bumps, place_bumps
 from .fit import Fit
 from .modes import TruthMode, wrap_rad
 
@@ -184,16 +184,10 @@ def evaluate(
     bg: Background,
     seed: int = 1,
     boot: int = 1000,
-    by_position: bool = False,
 ) -> HeldOut:
-    """Before (nominal) and after (`f`, None = nominal) on the held-out runs; `by_position`
-    (truth): the fit's floor bumps also go where a held-out wheel rolls over their spot
-    (bumps.place_by_position)."""
+    """Before (nominal) and after (`f`, None = nominal) on the held-out runs."""
     hprs = [prs[i] for i in held]
     P = apply(f, hprs, HELDOUT_BUMP_MIN_RUNS)
-    if by_position and f is not None and f.bumps:
-        truth = [items[i] for i in held if isinstance(items[i], TruthMode)]
-        place_by_position(truth, f.bumps, P)
     after = [run_gap(items[i], P, sigma, bg)[0] for i in held]
     clear_bumps(hprs)
     res = [run_gap(items[i], {}, sigma, bg) for i in held]
