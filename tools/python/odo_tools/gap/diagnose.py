@@ -7,7 +7,9 @@ Three steps, each its own function:
    per-run evidence objects (modes.EvidenceMode).
 2. `rank` on the fitting runs: every hypothesis the mode sees (hypotheses.singles), the other
    laws of the families the residual points to (hypotheses.propose), pairs and a third member
-   where they pay for themselves; evidence is BIC, pairs by quasi-BIC.
+   where they pay for themselves; evidence is BIC, pairs by quasi-BIC. In truth mode the
+   robot's geometry is then fitted to the fitting runs' accumulated tracks where the windows'
+   best leaves them far from the background (`_track_refit`).
 3. `judge` on the held-out runs (select.py chooses them): the measured background
    (background.py), the best candidate's held-out gap against it (heldout.py), the verdict
    (`decide`), and the parameters' stability across groups (stability.py).
