@@ -391,19 +391,17 @@ def _below_resolution(f: Fit, robot: Robot) -> set[str]:
     that 'significant': on the independent world's dev seed 7 case 0 (a set with count loss on
     its trailer) a 0.07 deg rotary bias, under half its 11-bit encoder's 0.18 deg step, joined
     the count loss. A bias smaller than the encoder resolves is not named as a member."""
-    out = set()
     lk = robot.linkage or robot.trailer or {}
     bits = lk.get("rotary_bits")
-    if "rotary_bias" in (f.hyp.families if f.hyp else ()) and bits:
-        half = 0.5 * 360.0 / (1 << int(bits))
-        vals = [v for k, v in f.params.items() if k.startswith("rotary_bias.")]
-        if vals and max(abs(v) for v in vals) < half:
-            out.add("rotary_bias")
-    res = lk.get("linear_resolution_mm")
-    if "link_bias" in (f.hyp.families if f.hyp else ()) and res:
-        vals = [v for k, v in f.params.items() if k.startswith("link_bias.")]
-        if vals and max(abs(v) for v in vals) < 0.5 * float(res):
-            out.add("link_bias")
+    steps = {  # the encoder step each bias is read in (deg, mm)
+        "rotary_bias": 360.0 / (1 << int(bits)) if bits else None,
+        "link_bias": lk.get("linear_resolution_mm"),
+    }
+    out = set()
+    for fam in set(f.hyp.families if f.hyp else ()) & steps.keys():
+        vals = [abs(v) for k, v in f.params.items() if k.startswith(fam + ".")]
+        if steps[fam] and vals and max(vals) < 0.5 * float(steps[fam]):
+            out.add(fam)
     return out
 
 

@@ -347,21 +347,34 @@ def count_loss_plateau(pr: Prepared, ds: np.ndarray, truck: int, P: dict) -> np.
     a = P.get("count_loss@plateau.a_m_s2", 1.0) * 1e3
     if E <= 0.0:
         return ds
+    out = ds.copy()
+    for w, i0, i1, tau, T, sg in _plateau_stretches(pr, truck, level):
+        ex = np.minimum(np.minimum(a * tau, a * (T - tau)), E)
+        out[i0:i1, w] += sg * ex.mean(axis=1) * pr.dt[i0:i1]
+    return out
+
+
+def _plateau_stretches(pr: Prepared, truck: int, level: float) -> list[tuple]:
+    """Per stretch of a wheel's saturated ticks: (wheel, first tick, end tick, (ticks, sub-steps)
+    times since the stretch began, its length, the wheel's direction per tick). Independent of
+    the law's parameters, so a fit that moves them reuses it (cached per truck and ceiling)."""
+    key = ("plateau", truck, level)
+    hit = pr.slip_cache.get(key)
+    if hit is not None:
+        return hit
     t = pr.t
     raw = pr.ds[:, truck, :]
     sat = np.abs(raw) / pr.dt[:, None] >= level * (1.0 - PLATEAU_TOL)
-    out = ds.copy()
     f = (np.arange(PLATEAU_SUB) + 0.5) / PLATEAU_SUB
+    out = []
     for w in (0, 1):
         m = np.concatenate([[False], sat[:, w], [False]]).astype(np.int8)
         starts = np.flatnonzero(np.diff(m) == 1)
         ends = np.flatnonzero(np.diff(m) == -1)
         for i0, i1 in zip(starts, ends, strict=True):
-            T = t[i1] - t[i0]
             tau = t[i0:i1, None] - t[i0] + f[None, :] * pr.dt[i0:i1, None]
-            ex = np.minimum(np.minimum(a * tau, a * (T - tau)), E)
-            extra = ex.mean(axis=1) * pr.dt[i0:i1]
-            out[i0:i1, w] += np.sign(raw[i0:i1, w]) * extra
+            out.append((w, i0, i1, tau, t[i1] - t[i0], np.sign(raw[i0:i1, w])))
+    _cache_put(pr.slip_cache, key, out)
     return out
 
 
