@@ -27,6 +27,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
+from threadpoolctl import threadpool_limits
 
 from . import catalog, hypotheses, instrument
 from .background import Background, measure
@@ -772,6 +773,27 @@ def diagnose(
     groups: list[str] | None = None,
 ) -> Report:
     """Diagnose the runs in `real` (a folder or a list of folders; module doc)."""
+    # one BLAS thread: the fits' matrices are small, and a second thread per process made a
+    # diagnosis slower alone (26 s against 21 s) and oversubscribed the cores when the blind
+    # check runs two diagnoses side by side (36.5 s)
+    with threadpool_limits(limits=1, user_api="blas"):
+        return _diagnose(
+            real,
+            robot_path,
+            holdout,
+            seed,
+            mode,
+            progress,
+            return_accuracy,
+            fit,
+            judge_runs,
+            groups,
+        )
+
+
+def _diagnose(
+    real, robot_path, holdout, seed, mode, progress, return_accuracy, fit, judge_runs, groups
+) -> Report:
     t0 = time.perf_counter()
     ds = load(real, robot_path, mode, return_accuracy, groups)
     sel = select_runs(ds, holdout, seed, fit, judge_runs)
