@@ -27,7 +27,7 @@ import math
 
 import numpy as np
 
-from .model import Prepared, dead_reckon
+from .model import Prepared, dead_reckon, track_at
 from .modes import WINDOW_S, Instrument, _body_inc, to_centre
 
 LATENCY_MAX_S = 0.5
@@ -253,7 +253,7 @@ def latency(
         """(shifts, 2 x windows): the residuals under every shift L (s) at once."""
         tm = t_ends[None, :] - L[:, None]
         ok = (tm[:, ie] >= pr.t[0]) & (tm[:, je] <= pr.t[-1])
-        mx, my, mth = (np.interp(tm, pr.t, p[:, k]) for k in range(3))
+        mx, my, mth = np.moveaxis(track_at(tm, pr.t, p[:, :3]), -1, 0)
         cm, sm = np.cos(mth[:, ie]), np.sin(mth[:, ie])
         ml = cm * (mx[:, je] - mx[:, ie]) + sm * (my[:, je] - my[:, ie])
         r = np.concatenate([(dth - (mth[:, je] - mth[:, ie])) * half_b, dlong - ml], axis=1)
@@ -283,19 +283,45 @@ def latency(
     return L
 
 
+CLOCK_OUTLIERS = 0.25  # at most this share of a session's runs (at least one) may disagree
+
+
+def _clock(vals: list[float], tick: float) -> float | None:
+    """The session's one clock offset, or None: the median of the runs that agree with the
+    session's median (within a third of it, or a quarter tick), when at most CLOCK_OUTLIERS of
+    its runs (at least one) do not. One run's shift is not the clock's: an eight or an
+    out-and-back whose effect moves the shift (the independent world's set with an Es read
+    21-27 ms on ten runs and 41 ms on its eight) must not take the session's clock away."""
+    v = np.array(vals, dtype=float)
+    med = float(np.median(v))
+    agree = np.abs(v - med) <= _tolerance(med, tick)
+    if v.size - int(agree.sum()) > max(1, int(CLOCK_OUTLIERS * v.size)):
+        return None
+    return float(np.median(v[agree]))
+
+
+def _tolerance(clock: float, tick: float) -> float:
+    return max(abs(clock) / 3.0, 0.25 * tick)
+
+
+def _tick(prs: list[Prepared]) -> float:
+    return float(np.median([float(np.median(pr.dt)) for pr in prs])) if prs else 0.0
+
+
 def one_clock(prs: list[Prepared], lat: dict[str, float]) -> dict[str, bool]:
-    """Per session: whether its runs' latencies look like one clock offset - within a third of
-    their median of each other, or a quarter tick. Slip taken for latency varies with how hard
-    each path accelerates (the simulator's slip read 12 ms on UMBmark, 25 ms on rect-7x4)."""
+    """Per session: whether all its runs' latencies look like one clock offset - within a third
+    of their median of each other, or a quarter tick (`diagnose._relatency`'s test of the
+    latencies under a candidate). Slip taken for latency varies with how hard each path
+    accelerates (the simulator's slip read 12 ms on UMBmark, 25 ms on rect-7x4)."""
     by: dict[str, list[float]] = {}
     for pr in prs:
         if pr.run.name in lat:
             by.setdefault(pr.run.session, []).append(lat[pr.run.name])
-    tick = float(np.median([float(np.median(pr.dt)) for pr in prs])) if prs else 0.0
+    tick = _tick(prs)
     out = {}
     for sess, vals in by.items():
         v = np.array(vals)
-        out[sess] = bool(np.ptp(v) <= max(abs(float(np.median(v))) / 3.0, 0.25 * tick))
+        out[sess] = bool(np.ptp(v) <= _tolerance(float(np.median(v)), tick))
     return out
 
 
@@ -306,7 +332,11 @@ def session_latencies(prs: list[Prepared], found: dict[str, float | None]) -> di
     """A run whose track does not fix its latency (a spin, a run an effect dominates) takes the
     median of its session's runs that do: the clock offset is the rig's (the independent
     world's squares with slip said nothing, its circles 30-37 ms, a spin 0.5 s at the grid's
-    edge)."""
+    edge). A session that runs on one clock (`_clock`) keeps each run's own shift where it
+    agrees with that clock and gives the clock to the few that do not (tried: the clock for
+    every run, which moved as many verdicts of the independent world one way as the other). A
+    session whose runs disagree keeps each run's own shift, but only where it is too long for
+    an effect to fake."""
     out = {}
     for pr in prs:
         name = pr.run.name
@@ -316,12 +346,20 @@ def session_latencies(prs: list[Prepared], found: dict[str, float | None]) -> di
         same = [found[p.run.name] for p in prs if p.run.session == pr.run.session]
         valid = [x for x in same if x is not None]
         out[name] = float(np.median(valid)) if valid else 0.0
-    # a session whose runs disagree keeps only the latencies too long for an effect to fake
-    clock = one_clock(prs, out)
+    tick = _tick(prs)
+    by: dict[str, list[str]] = {}
     for pr in prs:
-        L = out[pr.run.name]
-        if not clock.get(pr.run.session, True) and abs(L) < CLOCK_TICKS * float(np.median(pr.dt)):
-            out[pr.run.name] = 0.0
+        by.setdefault(pr.run.session, []).append(pr.run.name)
+    for names in by.values():
+        clock = _clock([out[n] for n in names], tick)
+        for pr in prs:
+            if pr.run.name not in names:
+                continue
+            if clock is not None:
+                if abs(out[pr.run.name] - clock) > _tolerance(clock, tick):
+                    out[pr.run.name] = clock
+            elif abs(out[pr.run.name]) < CLOCK_TICKS * float(np.median(pr.dt)):
+                out[pr.run.name] = 0.0
     return out
 
 
@@ -342,7 +380,7 @@ def lever_arm(
         if i.size == 0:
             continue
         p = dead_reckon(pr, P or {}, truck)
-        m = np.column_stack([np.interp(tt, pr.t, p[:, k]) for k in range(3)])
+        m = track_at(tt, pr.t, p[:, :3])
         off = inst.heading_offset_rad[truck] if truck < len(inst.heading_offset_rad) else 0.0
         inc_t = _body_inc(to_centre(tr.pose[:, truck : truck + 1], [(0.0, 0.0)], [off])[:, 0], i, j)
         inc_m = _body_inc(m, i, j)

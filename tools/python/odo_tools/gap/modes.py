@@ -24,6 +24,7 @@ from .model import (
     link_bias,
     rough_moments,
     rough_window_var,
+    track_at,
     truck_view,
     wrap_rad,
 )
@@ -207,10 +208,11 @@ class TruthMode:
         self._ends = np.union1d(self.i, self.j)
         self._ie = np.searchsorted(self._ends, self.i)
         self._je = np.searchsorted(self._ends, self.j)
-        # where the model's ticks fall among the truth samples
-        self.exact = self.tt.size <= pr.t.size and np.allclose(
-            np.interp(self.tt, pr.t, pr.t), self.tt, atol=1e-6
-        )
+        # whether every truth sample (after its latency) falls on a count tick: the model is
+        # then compared where it is known, with no interpolation between ticks
+        kt = np.clip(np.searchsorted(pr.t, self.tt), 1, pr.t.size - 1)
+        gap = np.minimum(np.abs(self.tt - pr.t[kt - 1]), np.abs(self.tt - pr.t[kt]))
+        self.exact = bool(np.all(gap <= 1e-6))
         lg = pr.run.log
         self.has_link = self.tlink is not None and lg.alpha_deg is not None
         bits = robot.linkage.get("rotary_bits", robot.trailer.get("rotary_bits", 10))
@@ -264,9 +266,17 @@ class TruthMode:
             ]
         )  # (trucks, nwin)
 
+    def _at(self, tq: np.ndarray, p: np.ndarray) -> np.ndarray:
+        """The model's (x, y, heading) track p at truth times tq: between ticks through
+        model.track_at; a truth taken at the ticks themselves needs no interpolation (the same
+        numbers, np.interp's speed)."""
+        if self.exact:
+            return np.column_stack([np.interp(tq, self.pr.t, p[:, k]) for k in range(3)])
+        return track_at(tq, self.pr.t, p[:, :3])
+
     def model_pose(self, P: dict, truck: int) -> np.ndarray:
         p = dead_reckon(self.pr, P, truck)
-        return np.column_stack([np.interp(self.tt, self.pr.t, p[:, k]) for k in range(3)])
+        return self._at(self.tt, p)
 
     def channels(self) -> list[str]:
         ch = []
@@ -299,7 +309,7 @@ class TruthMode:
         te = self.tt[self._ends]
         for t in range(self.trucks):
             p = dead_reckon(self.pr, P, t)
-            mp = np.column_stack([np.interp(te, self.pr.t, p[:, k]) for k in range(3)])
+            mp = self._at(te, p)
             m = _body_inc(mp, self._ie, self._je)
             cols.append(self.tinc[t] - m)
         if self.has_link:
@@ -330,7 +340,7 @@ class TruthMode:
         ANCHOR_S: a single motion-capture sample puts its 3e-4 rad of heading noise into every
         later position (2 mm after 7 m), more than the noise floor the gap is judged against."""
         p = dead_reckon(self.pr, P, truck)
-        m = np.column_stack([np.interp(self.tt, self.pr.t, p[:, k]) for k in range(3)])
+        m = self._at(self.tt, p)
         tp = self.tpose[:, truck]
         k = self.tt <= self.tt[0] + ANCHOR_S
         th0 = float(np.mean(tp[k, 2] - m[k, 2]))
