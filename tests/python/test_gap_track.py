@@ -91,7 +91,10 @@ def test_a_linkage_bias_below_half_an_encoder_step_is_no_member() -> None:
 
     set_ = Robot("r.json", "set", 0.04, [{}, {}], trailer={"rotary_bits": 11})
     clap = Robot(
-        "r.json", "clapper", 0.04, [{}, {}],
+        "r.json",
+        "clapper",
+        0.04,
+        [{}, {}],
         linkage={"rotary_bits": 10, "linear_resolution_mm": 0.1},
     )
 
@@ -125,3 +128,24 @@ def test_geometry_that_leaves_the_fitting_tracks_far_off_is_no_explanation(tmp_p
     real = tmp_path / "real"
     simulate_case(c, real, 2672 * 1000 + 53)
     assert D.diagnose(real, real / "robot.json").to_dict()["verdict"]["effect"] == "unexplained"
+
+
+def test_a_trailer_truck_s_own_es_is_tried_when_the_misfit_leans_to_it(tmp_path: Path) -> None:
+    """The independent world's seed 2681 case 57 (traced after that seed was measured): a
+    clapper whose truck B alone has an Es of 1.0067. Truck B holds 62 % of the excess misfit,
+    short of the 75 % that proposes every effect of one truck; the linked trucks share the
+    rest. Es on both trucks left R 20.9 ('unexplained'); B's own Es removes most of it (R 25.5 ->
+    4.4) and is sized within 15 % (1.0060; the remainder is not closed by any candidate)."""
+    rng = np.random.default_rng(2681)
+    c = [indep.draw_case(rng, k) for k in range(58)][57]
+    assert c["vehicle"] == "clapper" and c["laws"] == {"es": "diameter"}, (
+        "the independent world's seed 2681 case 57 changed; pick another one-truck Es"
+    )
+    assert c["scope"] == {"es": "B"}
+    real = tmp_path / "real"
+    indep.simulate_case(c, real, 2681 * 1000 + 57)
+    v = D.diagnose(real, real / "robot.json").to_dict()["verdict"]
+    assert v["effect"] == "es", v
+    assert v["best_hypothesis"] == "es[B]", v
+    es = c["true"]["effects"]["es"]["value"]
+    assert abs(v["params"]["es.value.B"] - es) < 0.15 * abs(es - 1.0), (v["params"], es)
