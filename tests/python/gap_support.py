@@ -45,3 +45,20 @@ def optiodom_dir() -> Path | None:
         if d.is_dir():
             return d
     return None
+
+
+def indep_case(seed: int, k: int, out: Path, vehicle: str, laws: dict) -> dict:
+    """The independent world's case k of `seed`, simulated into `out` exactly as `odo-gap blind`
+    draws and simulates it; the drawn vehicle and effect laws are checked first, so a change of
+    the world that moves the case fails here, by name, rather than in what a test asserts."""
+    import numpy as np
+    from odo_tools.validation import indep
+
+    rng = np.random.default_rng(seed)
+    c = [indep.draw_case(rng, i) for i in range(k + 1)][k]
+    assert c["vehicle"] == vehicle and c["laws"] == laws, (
+        f"the independent world's seed {seed} case {k} changed ({c['vehicle']}, {c['laws']}): "
+        "pick another case like it"
+    )
+    indep.simulate_case(c, out, seed * 1000 + k)
+    return c

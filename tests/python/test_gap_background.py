@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from gap_support import BUILD, SRC, odo_sim
+from gap_support import BUILD, SRC, indep_case, odo_sim
 
 
 @pytest.fixture(autouse=True)
@@ -252,15 +252,8 @@ def noisy_eb(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, float]:
     """The independent world's seed 2681 case 26 (traced after that seed was measured): a
     LabMate with an Eb of 0.9953 whose motion capture carries 0.28 deg of heading noise per
     sample at 200 Hz."""
-    from odo_tools.validation import indep
-
-    rng = np.random.default_rng(2681)
-    c = [indep.draw_case(rng, k) for k in range(27)][26]
-    assert c["vehicle"] == "labmate" and c["laws"] == {"eb": "load_patch"}, (
-        "the independent world's seed 2681 case 26 changed; pick another noisy-truth Eb"
-    )
     real = tmp_path_factory.mktemp("noisy") / "real"
-    indep.simulate_case(c, real, 2681 * 1000 + 26)
+    c = indep_case(2681, 26, real, "labmate", {"eb": "load_patch"})
     return real, c["true"]["effects"]["eb"]["value0"]
 
 

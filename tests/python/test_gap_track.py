@@ -11,6 +11,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from gap_support import indep_case
 from odo_tools.gap import diagnose as D
 from odo_tools.gap.fit import Problem
 from odo_tools.validation import indep
@@ -71,13 +72,8 @@ def test_a_member_that_only_helps_the_runs_it_was_fitted_to_stays_out(tmp_path: 
     the catalog's does not have. On the fitting runs' tracks a tiny Ed beside the scrub halved
     what was left (R 2.13 -> 1.03) and the held-out runs came out worse (3.71 -> 4.36 x the
     background); left out of its fit, each path says so (diagnose._track_cv)."""
-    rng = np.random.default_rng(8)
-    c = [indep.draw_case(rng, k) for k in range(7)][6]
-    assert c["vehicle"] == "labmate" and c["laws"] == {"scrub": "torque"}, (
-        "the independent world's seed 8 case 6 changed; pick another torque-law scrub"
-    )
     real = tmp_path / "real"
-    indep.simulate_case(c, real, 8 * 1000 + 6)
+    indep_case(8, 6, real, "labmate", {"scrub": "torque"})
     v = D.diagnose(real, real / "robot.json").to_dict()["verdict"]
     assert v["effect"] == "scrub", v
 
@@ -136,14 +132,9 @@ def test_a_trailer_truck_s_own_es_is_tried_when_the_misfit_leans_to_it(tmp_path:
     short of the 75 % that proposes every effect of one truck; the linked trucks share the
     rest. Es on both trucks left R 20.9 ('unexplained'); B's own Es removes most of it (R 25.5 ->
     4.4) and is sized within 15 % (1.0060; the remainder is not closed by any candidate)."""
-    rng = np.random.default_rng(2681)
-    c = [indep.draw_case(rng, k) for k in range(58)][57]
-    assert c["vehicle"] == "clapper" and c["laws"] == {"es": "diameter"}, (
-        "the independent world's seed 2681 case 57 changed; pick another one-truck Es"
-    )
-    assert c["scope"] == {"es": "B"}
     real = tmp_path / "real"
-    indep.simulate_case(c, real, 2681 * 1000 + 57)
+    c = indep_case(2681, 57, real, "clapper", {"es": "diameter"})
+    assert c["scope"] == {"es": "B"}
     v = D.diagnose(real, real / "robot.json").to_dict()["verdict"]
     assert v["effect"] == "es", v
     assert v["best_hypothesis"] == "es[B]", v
@@ -157,13 +148,8 @@ def test_a_member_that_bends_the_fitting_tracks_away_is_refused(tmp_path: Path) 
     An Eb beside the trailer's Es won 21 BIC on the windows and took the fitting runs' tracks
     from 6 to 122 x the background (held-out 32 -> 127, 'unexplained'). A member that makes
     the fitting tracks worse by TRACK_GAIN is not one."""
-    rng = np.random.default_rng(2681)
-    c = [indep.draw_case(rng, k) for k in range(32)][31]
-    assert c["vehicle"] == "set" and c["laws"] == {"es": "deflection"}, (
-        "the independent world's seed 2681 case 31 changed; pick another trailer Es"
-    )
     real = tmp_path / "real"
-    indep.simulate_case(c, real, 2681 * 1000 + 31)
+    indep_case(2681, 31, real, "set", {"es": "deflection"})
     ds, sel, rk = _ranked(real)
     single = next(f for f in rk.cands if f.name == "es[B]")
     pair = next(f for f in rk.cands if f.name == "eb+es[B]")
@@ -181,13 +167,8 @@ def test_a_linkage_bias_is_not_traded_for_geometry_the_tracks_prefer(tmp_path: P
     whose hitch encoder reads 1.28 deg off. The windows name the rotary bias by 20244 BIC; the
     track fit, which leaves the linkage readings out, replaced it with an Ed that moved nothing
     (held-out R 3.07 -> 3.06, 'unexplained'). A sensor's bias is not the track fit's to judge."""
-    rng = np.random.default_rng(2681)
-    c = [indep.draw_case(rng, k) for k in range(34)][33]
-    assert c["vehicle"] == "set" and c["laws"] == {"rotary_bias": "constant"}, (
-        "the independent world's seed 2681 case 33 changed; pick another rotary bias"
-    )
     real = tmp_path / "real"
-    indep.simulate_case(c, real, 2681 * 1000 + 33)
+    c = indep_case(2681, 33, real, "set", {"rotary_bias": "constant"})
     v = D.diagnose(real, real / "robot.json").to_dict()["verdict"]
     assert v["effect"] == "rotary_bias", v
     a = c["params"]["rotary_bias.alpha_deg"]
