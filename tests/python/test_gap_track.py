@@ -108,6 +108,11 @@ def test_a_linkage_bias_below_half_an_encoder_step_is_no_member() -> None:
     assert D._below_resolution(fit(("link_bias",), link, "clapper"), clap) == {"link_bias"}
     link["link_bias.const_mm"] = 0.5
     assert not D._below_resolution(fit(("link_bias",), link, "clapper"), clap)
+    # a link-length bias within the lever arms taken off the tracked points (independent seed
+    # 2691 case 50: 1.25 mm beside a 2.1 mm lever arm estimated on a truck that has none)
+    link = {"link_bias.const_mm": 1.25, "link_bias.ecc_mm": -0.48}
+    assert D._below_resolution(fit(("link_bias",), link, "clapper"), clap, 2.06) == {"link_bias"}
+    assert not D._below_resolution(fit(("link_bias",), link, "clapper"), clap, 1.0)
 
 
 def test_geometry_that_leaves_the_fitting_tracks_far_off_is_no_explanation(tmp_path: Path) -> None:
