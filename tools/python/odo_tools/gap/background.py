@@ -120,8 +120,7 @@ class Background:
             Sc, Scc, Scy = cs(e * c), cs(e * c * c), cs(e * c * y)
             Ss, Sss, Ssx = cs(e * s_), cs(e * s_ * s_), cs(e * s_ * x)
             kk = k_end
-            Px = track_at(tw, pr.t, p[:, 0])
-            Py = track_at(tw, pr.t, p[:, 1])
+            Px, Py = track_at(tw, pr.t, p[:, :2]).T
             a = sw / b
             # E[gx^2 e] = sum e (c/2 + a (Py - y))^2
             vx = (

@@ -296,7 +296,7 @@ def rank(ds: Dataset, sel: Selection, progress: Progress = None) -> Ranking:
         # what one truck's geometry does: an Es on the trailer of a set left 62 %, an Eb 53 %):
         # that truck's own geometry, four cheap fits (independent world, seed 2681 cases 57, 14)
         lean = "AB"[int(np.argmax(trucks))]
-        geo = [h for h in list(hyps) if len(h.laws) == 1 and h.families[0] in THIRDS]
+        geo = [h for h in hyps if len(h.laws) == 1 and h.families[0] in THIRDS]
         hyps += [v for v in (hypotheses.on_truck(h, lean) for h in geo) if v is not None]
     singles = []
     for h in hyps:

@@ -347,18 +347,17 @@ def session_latencies(prs: list[Prepared], found: dict[str, float | None]) -> di
         valid = [x for x in same if x is not None]
         out[name] = float(np.median(valid)) if valid else 0.0
     tick = _tick(prs)
-    by: dict[str, list[str]] = {}
+    by: dict[str, list[Prepared]] = {}
     for pr in prs:
-        by.setdefault(pr.run.session, []).append(pr.run.name)
-    for names in by.values():
-        clock = _clock([out[n] for n in names], tick)
-        for pr in prs:
-            if pr.run.name not in names:
-                continue
+        by.setdefault(pr.run.session, []).append(pr)
+    for same in by.values():
+        clock = _clock([out[pr.run.name] for pr in same], tick)
+        for pr in same:
+            L = out[pr.run.name]
             if clock is not None:
-                if abs(out[pr.run.name] - clock) > _tolerance(clock, tick):
+                if abs(L - clock) > _tolerance(clock, tick):
                     out[pr.run.name] = clock
-            elif abs(out[pr.run.name]) < CLOCK_TICKS * float(np.median(pr.dt)):
+            elif abs(L) < CLOCK_TICKS * float(np.median(pr.dt)):
                 out[pr.run.name] = 0.0
     return out
 

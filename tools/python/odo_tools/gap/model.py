@@ -556,6 +556,13 @@ def _track(pr: Prepared, P: dict, truck: int) -> np.ndarray:
 TRACK_CACHE = 24
 
 
+def interp_track(tq, t: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """np.interp of a track y ((n,) or (n, columns)) at the times tq, column by column."""
+    if y.ndim == 1:
+        return np.interp(tq, t, y)
+    return np.stack([np.interp(tq, t, y[:, c]) for c in range(y.shape[1])], axis=-1)
+
+
 def track_at(tq, t: np.ndarray, y: np.ndarray) -> np.ndarray:
     """The model's track y ((n,) or (n, columns), sampled at the count ticks t) at the times tq
     (any shape; clamped to the ends like np.interp): a cubic Hermite through the ticks with
@@ -567,9 +574,7 @@ def track_at(tq, t: np.ndarray, y: np.ndarray) -> np.ndarray:
     tq = np.asarray(tq, dtype=float)
     n = t.size
     if n < 3:
-        if y.ndim == 1:
-            return np.interp(tq, t, y)
-        return np.stack([np.interp(tq, t, y[:, c]) for c in range(y.shape[1])], axis=-1)
+        return interp_track(tq, t, y)
     k = np.clip(np.searchsorted(t, tq, side="right") - 1, 0, n - 2)
     km, kp = np.maximum(k - 1, 0), np.minimum(k + 2, n - 1)
     t0, t1 = t[k], t[k + 1]

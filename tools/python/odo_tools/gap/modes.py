@@ -21,6 +21,7 @@ from .io import Robot
 from .model import (
     Prepared,
     dead_reckon,
+    interp_track,
     link_bias,
     rough_moments,
     rough_window_var,
@@ -270,9 +271,7 @@ class TruthMode:
         """The model's (x, y, heading) track p at truth times tq: between ticks through
         model.track_at; a truth taken at the ticks themselves needs no interpolation (the same
         numbers, np.interp's speed)."""
-        if self.exact:
-            return np.column_stack([np.interp(tq, self.pr.t, p[:, k]) for k in range(3)])
-        return track_at(tq, self.pr.t, p[:, :3])
+        return (interp_track if self.exact else track_at)(tq, self.pr.t, p[:, :3])
 
     def model_pose(self, P: dict, truck: int) -> np.ndarray:
         p = dead_reckon(self.pr, P, truck)
@@ -339,8 +338,7 @@ class TruthMode:
         The start pose is the mean offset of the truth from the model over the first
         ANCHOR_S: a single motion-capture sample puts its 3e-4 rad of heading noise into every
         later position (2 mm after 7 m), more than the noise floor the gap is judged against."""
-        p = dead_reckon(self.pr, P, truck)
-        m = self._at(self.tt, p)
+        m = self.model_pose(P, truck)
         tp = self.tpose[:, truck]
         k = self.tt <= self.tt[0] + ANCHOR_S
         th0 = float(np.mean(tp[k, 2] - m[k, 2]))
