@@ -208,6 +208,42 @@ def test_returns_spread_pools_paths_and_counts_its_degrees_of_freedom() -> None:
     assert s == pytest.approx(sig, rel=0.08)
 
 
+def test_start_heading_spreads_an_open_paths_return_by_its_reach() -> None:
+    """A start placed off by a heading d ~ N(0, s) turns the whole run about its start point:
+    returns of a path ending at (9 m, -6 m), simulated with 20 000 placements, spread by what
+    ReturnsMode.own_var says, per axis; a closed path's return (at its start) not at all."""
+    from types import SimpleNamespace
+
+    from odo_tools.gap.modes import ReturnsMode
+
+    rng = np.random.default_rng(5)
+    s = 0.002
+    sigma = np.array([1.0, 1.0, s])
+    for end in ((9000.0, -6000.0), (0.0, 0.0)):
+        ret = np.array([end[0], end[1], 0.3])
+        mode = ReturnsMode(SimpleNamespace(run=SimpleNamespace(ret=ret)), None)
+        d = rng.normal(0.0, s, 20000)
+        x = np.cos(d) * end[0] - np.sin(d) * end[1]
+        y = np.sin(d) * end[0] + np.cos(d) * end[1]
+        v = mode.own_var(sigma)[0]
+        assert v[2] == 0.0
+        assert math.sqrt(v[0]) == pytest.approx(np.std(x), rel=0.03, abs=1e-9)
+        assert math.sqrt(v[1]) == pytest.approx(np.std(y), rel=0.03, abs=1e-9)
+
+
+def test_a_long_open_run_without_effect_is_no_gap_in_returns_mode(tmp_path: Path) -> None:
+    """Independent world, seed 2691 case 43: a LabMate with no effect whose one 'drive' run ends
+    11 m from its start 24 mm off the nominal model, 0.13 deg of start heading over that reach,
+    while its squares' returns spread by 1 mm. Judged against the squares' spread alone it was
+    "unexplained"; with the start heading's reach it is no gap."""
+    from odo_tools.gap.diagnose import diagnose
+
+    real = tmp_path / "real"
+    indep_case(2691, 43, real, "labmate", {})
+    v = diagnose(real, real / "robot.json", mode="returns").to_dict()["verdict"]
+    assert v["effect"] == "no significant gap", v
+
+
 def test_walk_of_single_run_paths_is_measured_against_the_held_out_runs(tmp_path: Path) -> None:
     """Fitting runs that each drove a path of their own cannot tell a walk from what repeats:
     the whole residual left under the candidate was taken for the floor's walk, and the allowance

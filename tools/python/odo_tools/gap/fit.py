@@ -77,6 +77,9 @@ class Problem:
             for it in self.items:
                 n = it.residuals({}).shape[0]
                 v = np.broadcast_to(self.sigma**2, (n, self.sigma.size)).copy()
+                own = it.own_var(self.sigma)
+                if own is not None:
+                    v += own
                 if not rough and self.walk is not None:
                     w = self.walk.window_var(it)
                     if w is not None:

@@ -154,8 +154,9 @@ def run_gap(item, P: dict, sigma: np.ndarray, bg: Background) -> tuple[RunGap, f
     if item.name == "returns":
         mm = float(math.hypot(r[0, 0], r[0, 1]))
         deg = float(abs(math.degrees(r[0, 2])))
-        bmm = float(math.hypot(sigma[0], sigma[1]))
-        bdeg = float(math.degrees(sigma[2]))
+        v = sigma**2 + item.own_var(sigma)[0]
+        bmm = float(math.sqrt(v[0] + v[1]))
+        bdeg = float(math.degrees(math.sqrt(v[2])))
     else:
         mm = item.gap(P)
         deg = float(np.degrees(np.sqrt(np.mean(r[:, 0] ** 2))))
