@@ -33,6 +33,7 @@ EXTRA_BOUNDS = {
     "slip.tau_s": (0.0005, 0.02, 0.004),
     "slip@accel.k_per_m_s2": (0.0, 5.0, 0.05),
     "slip@accel.a0_m_s2": (0.0, 5.0, 0.2),
+    "slip@accel.asym": (-0.9, 0.9, 0.0),
     "slip@traction.a_max_m_s2": (0.05, 20.0, 2.0),
     "count_loss@speed.k_per_m_s": (0.0, 20.0, 0.2),
     "count_loss@speed.v0_mm_s": (0.0, 5000.0, 300.0),
@@ -77,8 +78,9 @@ OTHER_LAWS = {
         Law(
             "slip",
             "accel",
-            ("slip@accel.k_per_m_s2", "slip@accel.a0_m_s2"),
-            "slip fraction k max(0, |a| - a0) on the acceleration the counts show, tick by tick",
+            ("slip@accel.k_per_m_s2", "slip@accel.a0_m_s2", "slip@accel.asym"),
+            "slip fraction k (1 -/+ asym) max(0, |a| - a0) on the acceleration the counts show, "
+            "tick by tick, left/right",
         ),
         Law(
             "slip",

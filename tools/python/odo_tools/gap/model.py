@@ -253,16 +253,20 @@ def _wheel_speeds(pr: Prepared, ds: np.ndarray) -> np.ndarray:
 
 def slip_accel(pr: Prepared, ds: np.ndarray, P: dict) -> np.ndarray:
     """Slip tied to the wheel's acceleration as the counts show it, tick by tick: fraction
-    s = min(cap, k max(0, |a| - a0)) with a the change of the tick's mean speed; speeding up the
-    wheel spins (floor = (1 - s) counted), slowing down it drags (floor = counted / (1 - s)). No
-    motor lag, no sub-steps: the law a user would write down from the counts alone."""
+    s = min(cap, k (1 -/+ asym) max(0, |a| - a0)) on the left/right wheel, a the change of the
+    tick's mean speed; speeding up the wheel spins (floor = (1 - s) counted), slowing down it
+    drags (floor = counted / (1 - s)). No motor lag, no sub-steps: the law a user would write
+    down from the counts alone. Tyres differ: with one k for both, a truck that turned a little
+    on every start left 5.9 x the background (independent world, seed 2701 case 2)."""
     k = P["slip@accel.k_per_m_s2"]
     a0 = P.get("slip@accel.a0_m_s2", 0.0)
+    asym = P.get("slip@accel.asym", 0.0)
     cap = 0.5
     v = _wheel_speeds(pr, ds)
     vp = np.vstack([np.zeros((1, 2)), v[:-1]])
     a = np.abs(v - vp) / pr.dt[:, None] * 1e-3
-    s = np.minimum(k * np.maximum(a - a0, 0.0), cap)
+    kw = k * np.array([1.0 - asym, 1.0 + asym])
+    s = np.minimum(kw * np.maximum(a - a0, 0.0), cap)
     up = np.abs(v) >= np.abs(vp)
     return ds * np.where(up, 1.0 - s, 1.0 / (1.0 - s))
 
