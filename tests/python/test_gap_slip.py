@@ -41,6 +41,26 @@ def test_asymmetric_accel_slip_spins_one_wheel_more_and_turns_the_truck() -> Non
     assert np.sum(out[:, 0]) > np.sum(out[:, 1])
 
 
+def test_traction_left_to_speed_up_shrinks_with_the_turns_lateral_acceleration() -> None:
+    """Wheels speeding up by 1.25 and 1.875 m/s^2 under a 3 m/s^2 traction limit: the floor
+    keeps up with both while the turn is slow; once the arc's lateral acceleration v w passes
+    2.7 m/s^2 the friction circle leaves less than 1.3 m/s^2 to speed up, and both spin."""
+    from odo_tools.gap.model import slip_traction
+
+    b = 200.0
+    pr, ds = _ramp(20, 50.0)
+    assert np.allclose(slip_traction(pr, ds, 3.0, b), ds)  # straight: 1.25 m/s^2 < 3
+    arc = ds * np.array([1.0, 1.5])
+    v = arc / pr.dt[:, None]
+    alat = 0.5 * (v[:, 0] + v[:, 1]) * (v[:, 1] - v[:, 0]) / b
+    floor = slip_traction(pr, arc, 3.0, b)
+    tight = alat > 2700.0
+    assert tight.sum() >= 2
+    assert np.all(floor[tight] < arc[tight] - 1e-9)
+    loose = alat < 2000.0
+    assert np.allclose(floor[loose], arc[loose])
+
+
 def test_asymmetric_accel_slip_is_named(tmp_path: Path) -> None:
     """Independent world, seed 2701 case 2: a LabMate whose right tyre slips 1.8 x as much as
     its left under acceleration (k 0.079 at 1 m/s^2, power 1.46). Symmetric, the accel law left
@@ -51,3 +71,17 @@ def test_asymmetric_accel_slip_is_named(tmp_path: Path) -> None:
     indep_case(2701, 2, real, "labmate", {"slip": "accel"})
     v = diagnose(real, real / "robot.json").to_dict()["verdict"]
     assert v["effect"] == "slip", v
+
+
+def test_traction_slip_on_arcs_is_not_read_as_truth_latency(tmp_path: Path) -> None:
+    """Independent world, seed 2701 case 21: a LabMate whose floor speed changes at most
+    0.92 m/s^2 (traction law, the friction circle's share on arcs) under a controller that asks
+    1.09. Its starts lag the counts like a 100 ms late truth; read as latency, the traction law
+    left 34 x the background ("unexplained"). As slip, with the circle, it is named."""
+    from odo_tools.gap.diagnose import diagnose
+
+    real = tmp_path / "real"
+    indep_case(2701, 21, real, "labmate", {"slip": "traction"})
+    rep = diagnose(real, real / "robot.json").to_dict()
+    assert rep["verdict"]["effect"] == "slip", rep["verdict"]
+    assert max(abs(v) for v in rep["instrument"]["latency_s"].values()) < 0.05

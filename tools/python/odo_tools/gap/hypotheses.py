@@ -86,7 +86,8 @@ OTHER_LAWS = {
             "slip",
             "traction",
             ("slip@traction.a_max_m_s2",),
-            "traction (torque) saturation: the floor speed follows the wheel at most a_max",
+            "traction (torque) saturation: the floor speed follows the wheel at most by what "
+            "the friction circle of a_max leaves beside the turn's lateral acceleration",
         ),
     ),
     "count_loss": (

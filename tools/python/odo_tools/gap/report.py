@@ -37,8 +37,10 @@ WORDS = {
 }
 LAW_WORDS = {
     "catalog": "the catalog's law",
-    "accel": "slip fraction proportional to the wheel's acceleration above a threshold",
-    "traction": "traction (torque) saturation: the floor speed changes by at most a_max",
+    "accel": "slip fraction proportional to the wheel's acceleration above a threshold, "
+    "one grip per tyre",
+    "traction": "traction (torque) saturation: the floor speed changes by at most what the "
+    "friction circle of a_max leaves beside the turn",
     "speed": "a fraction of the counts lost above a wheel speed",
 }
 # effects a parameter block corrects (odo-calib): what a next step can fix on the robot
