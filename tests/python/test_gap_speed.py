@@ -37,14 +37,18 @@ def test_traction_rate_limiter_is_the_per_tick_clip_bit_for_bit() -> None:
     ds = _wheels(rng, 1500)
     pr = _prepared(ds[:, None, :])
     pr.dt = 0.02 + rng.uniform(0.0, 1e-4, ds.shape[0])  # jittered ticks
+    b = pr.b[0]
     for a_max in (0.05, 0.8, 3.0, 20.0):
         v = ds / pr.dt[:, None]
-        lim = a_max * 1e3 * pr.dt
+        # the friction circle's share per tick (model.slip_traction), then the plain clip
+        a = a_max * 1e3
+        alat = np.abs(0.5 * (v[:, 0] + v[:, 1]) * (v[:, 1] - v[:, 0]) / b)
+        lim = np.sqrt(np.maximum(a * a - alat * alat, (0.1 * a) ** 2)) * pr.dt
         u, cur = np.empty_like(v), np.zeros(2)
         for i in range(v.shape[0]):  # the form it replaced: one numpy clip per tick
             cur = cur + np.clip(v[i] - cur, -lim[i], lim[i])
             u[i] = cur
-        got = slip_traction(pr, ds, a_max)
+        got = slip_traction(pr, ds, a_max, b)
         assert np.array_equal(got, u * pr.dt[:, None]), a_max
         if a_max < 1.0:
             assert not np.allclose(got, ds)  # the limiter bites: the comparison can fail
