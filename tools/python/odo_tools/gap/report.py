@@ -574,6 +574,16 @@ def _remainder(rep: dict) -> str:
             "the spread of repeated runs of one path: "
             + ", ".join(f"{k} {v:.3g}" for k, v in s.items())
         )
+        # a run that ends away from its start also carries its start heading over that reach
+        # (modes.ReturnsMode.own_var): say where that made the allowance
+        spread = math.hypot(s.get("x_mm", 0.0), s.get("y_mm", 0.0))
+        reach = [(b, r) for b, r in zip(hd["background_mm"], hd["runs"], strict=False)]
+        b, run = max(reach, default=(0.0, ""))
+        if b > 1.1 * spread:
+            parts.append(
+                f"and the start heading ({s.get('theta_rad', 0.0):.3g} rad) over the reach of "
+                f"runs that end away from their start (up to {b:.1f} mm, {run})"
+            )
     r1 = hd["ratio_after"]
     if r1 <= 1.5:
         parts.append(f"{r1:.2f} x the background: nothing systematic is left")
