@@ -62,3 +62,19 @@ def indep_case(seed: int, k: int, out: Path, vehicle: str, laws: dict) -> dict:
     )
     indep.simulate_case(c, out, seed * 1000 + k)
     return c
+
+
+def sim_case(seed: int, k: int, out: Path, vehicle: str, effects: list) -> dict:
+    """The simulator world's case k of `seed`, simulated into `out` as `odo-gap blind --world
+    sim` draws and simulates it; the drawn vehicle and effects are checked first (indep_case)."""
+    import numpy as np
+    from odo_tools.validation import blind
+
+    rng = np.random.default_rng(seed)
+    c = [blind.draw_case(rng, i) for i in range(k + 1)][k]
+    assert c["vehicle"] == vehicle and list(c["effects"]) == effects, (
+        f"the simulator world's seed {seed} case {k} changed ({c['vehicle']}, {c['effects']}): "
+        "pick another case like it"
+    )
+    blind.simulate_case(c, out, seed * 1000 + k)
+    return c

@@ -85,3 +85,23 @@ def test_traction_slip_on_arcs_is_not_read_as_truth_latency(tmp_path: Path) -> N
     rep = diagnose(real, real / "robot.json").to_dict()
     assert rep["verdict"]["effect"] == "slip", rep["verdict"]
     assert max(abs(v) for v in rep["instrument"]["latency_s"].values()) < 0.05
+
+
+def test_slip_read_as_latency_is_told_apart_before_the_pairs(tmp_path: Path) -> None:
+    """Simulator world, seed 2712 case 28: a clapper with catalog slip (k 0.98 per m/s^2) and a
+    truth without latency, whose starts read as 97 ms on four runs. With slip among the top
+    singles the ranking asks at once whether the latency is the slip, drops it, and ranks again
+    before fitting any pair (it used to fit pairs and a triple first: 34 s of 10-run diagnosis
+    for 18 s); the verdict is slip either way."""
+    from gap_support import sim_case
+    from odo_tools.gap.diagnose import diagnose
+
+    real = tmp_path / "real"
+    sim_case(2712, 28, real, "clapper", ["slip"])
+    said: list[str] = []
+    rep = diagnose(real, real / "robot.json", mode="truth", progress=said.append).to_dict()
+    assert rep["verdict"]["effect"] == "slip", rep["verdict"]
+    told = said.index("latency and slip told apart: ranking again")
+    assert not any(m.startswith("fitting") and "+" in m for m in said[:told]), said[:told]
+    assert said.count("latency and slip told apart: ranking again") == 1
+    assert max(abs(v) for v in rep["instrument"]["latency_s"].values()) == 0.0
