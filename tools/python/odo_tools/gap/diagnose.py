@@ -313,8 +313,7 @@ def rank(ds: Dataset, sel: Selection, progress: Progress = None) -> Ranking:
         # ranking, `_slip_not_latency`, then finds no latency left). A clapper whose catalog
         # slip read as 97 ms fitted pairs and a triple for 20 s before that (simulator, seed
         # 2712 case 28: 34 s in all)
-        early = Ranking(prob, null, singles, list(singles), singles[0], 1.0, None, {}, {})
-        if _slip_not_latency(ds, sel, early, slip):
+        if _slip_not_latency(ds, sel, prob, singles[0], slip):
             if progress:
                 progress("latency and slip told apart: ranking again")
             rk = rank(ds, sel, progress)
@@ -775,7 +774,9 @@ def _relatency(ds: Dataset, sel: Selection, rk: Ranking) -> bool:
 SLIP_EARLY = 3  # a slip single this high among the singles is asked about latency at once
 
 
-def _slip_not_latency(ds: Dataset, sel: Selection, rk: Ranking, cand: Fit | None = None) -> bool:
+def _slip_not_latency(
+    ds: Dataset, sel: Selection, ranked: Problem, best: Fit, cand: Fit | None = None
+) -> bool:
     """The converse of `_relatency`: runs given a latency - is the latency the robot's slip?
     The best candidate (plus catalog slip when it has none) is fitted on the items without
     latency; if that explains the fitting runs better (each latency one parameter), the
@@ -784,9 +785,9 @@ def _slip_not_latency(ds: Dataset, sel: Selection, rk: Ranking, cand: Fit | None
     A candidate with slip is asked too: the instrument's latency is fitted before any effect,
     and a truck that spins on every start lags its counts like a late truth (independent world,
     seed 2701 case 21: 95-110 ms read for a 20 ms truth, and the traction law then left the
-    held-out runs at 34 x the background; without them, slip at 11 x from 89). `cand`: the
-    candidate to ask with instead (rank: the slip single, before any pair)."""
-    best = rk.best
+    held-out runs at 34 x the background; without them, slip at 11 x from 89). `ranked`: the
+    problem `best` was ranked on; `cand`: the candidate to ask with instead of `best` (rank: the
+    slip single, before any pair)."""
     if ds.mode != "truth" or ds.instrument is None or best.hyp is None:
         return False
     fprs = [ds.prs[i] for i in sel.fit]
@@ -796,8 +797,8 @@ def _slip_not_latency(ds: Dataset, sel: Selection, rk: Ranking, cand: Fit | None
     inst = ds.instrument.copy()
     inst.latency_s = {k: 0.0 for k in ds.instrument.latency_s}
     items = [TruthMode(pr, ds.robot, inst) for pr in ds.prs]
-    prob = Problem("truth", [items[i] for i in sel.fit], rk.prob.sigma)
-    prob.set_background(rk.prob.walk, rk.prob.sigma)
+    prob = Problem("truth", [items[i] for i in sel.fit], ranked.sigma)
+    prob.set_background(ranked.walk, ranked.sigma)
     ask = cand if cand is not None else best
     hyp = ask.hyp
     if "slip" not in hyp.families:
@@ -852,7 +853,7 @@ def _diagnose(
     ds = load(real, robot_path, mode, return_accuracy, groups)
     sel = select_runs(ds, holdout, seed, fit, judge_runs)
     rk = rank(ds, sel, progress)
-    if not rk.retimed and (_relatency(ds, sel, rk) or _slip_not_latency(ds, sel, rk)):
+    if not rk.retimed and (_relatency(ds, sel, rk) or _slip_not_latency(ds, sel, rk.prob, rk.best)):
         if progress:
             progress("latency and slip told apart: ranking again")
         rk = rank(ds, sel, progress)

@@ -577,8 +577,7 @@ def _remainder(rep: dict) -> str:
         # a run that ends away from its start also carries its start heading over that reach
         # (modes.ReturnsMode.own_var): say where that made the allowance
         spread = math.hypot(s.get("x_mm", 0.0), s.get("y_mm", 0.0))
-        reach = [(b, r) for b, r in zip(hd["background_mm"], hd["runs"], strict=False)]
-        b, run = max(reach, default=(0.0, ""))
+        b, run = max(zip(hd["background_mm"], hd["runs"], strict=False), default=(0.0, ""))
         if b > 1.1 * spread:
             parts.append(
                 f"and the start heading ({s.get('theta_rad', 0.0):.3g} rad) over the reach of "
