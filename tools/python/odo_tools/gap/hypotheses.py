@@ -39,6 +39,7 @@ EXTRA_BOUNDS = {
     "count_loss@speed.v0_mm_s": (0.0, 5000.0, 300.0),
     "count_loss@plateau.excess_mm_s": (0.0, 5000.0, 400.0),
     "count_loss@plateau.a_m_s2": (0.05, 20.0, 1.0),
+    "skid@cornering.deg_per_m_s2": (0.0, 30.0, 1.0),
 }
 START = {"slip.k_per_m_s2": 0.05, "skid.k_s": 0.05, "roughness.max_height_mm": 0.5}
 
@@ -88,6 +89,15 @@ OTHER_LAWS = {
             ("slip@traction.a_max_m_s2",),
             "traction (torque) saturation: the floor speed follows the wheel at most by what "
             "the friction circle of a_max leaves beside the turn's lateral acceleration",
+        ),
+    ),
+    "skid": (
+        Law(
+            "skid",
+            "cornering",
+            ("skid@cornering.deg_per_m_s2",),
+            "linear cornering stiffness: a slip angle proportional to the centripetal "
+            "acceleration, from the gentlest arc up (no threshold)",
         ),
     ),
     "count_loss": (
@@ -196,6 +206,7 @@ def bounds(key: str) -> tuple[float, float, float]:
 PROPOSE = {
     "slip": ("acceleration",),
     "count_loss": ("fast",),
+    "skid": ("arc",),
 }
 PROPOSE_SHARE = 0.25  # a phase holding this share of the excess misfit proposes its families
 PROPOSE_DENSITY = 2.0  # ... or this many times its share of the run

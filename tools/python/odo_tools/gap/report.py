@@ -42,6 +42,8 @@ LAW_WORDS = {
     "traction": "traction (torque) saturation: the floor speed changes by at most what the "
     "friction circle of a_max leaves beside the turn",
     "speed": "a fraction of the counts lost above a wheel speed",
+    "cornering": "linear cornering stiffness: the tyres run at a slip angle proportional to the "
+    "centripetal acceleration, from the gentlest arc up (no threshold)",
 }
 # effects a parameter block corrects (odo-calib): what a next step can fix on the robot
 KINEMATIC = ("ed", "eb", "es", "scrub")
@@ -69,6 +71,7 @@ def unit(key: str) -> str:
             "a_max_m_s2": "m/s^2",
             "k_per_m_s": "1/(m/s)",
             "v0_mm_s": "mm/s",
+            "deg_per_m_s2": "deg/(m/s^2)",
         }.get(p, "")
     return "" if u in ("1", "-") else u
 
