@@ -222,15 +222,21 @@ def floor_travel(
     g = scrub_factor(ds, P.get("scrub.k", 0.0)) if drive else None
     ks = P.get("skid.k_s", 0.0) if drive else 0.0
     if ks > 0:
-        v = 0.5 * (ds[:, 0] + ds[:, 1]) / pr.dt
-        om = (ds[:, 1] - ds[:, 0]) / bt / pr.dt * (1.0 if g is None else g)
-        ac = v * om * 1e-3
+        ac = centripetal(pr, ds, bt, g)
         ex = np.maximum(np.abs(ac) - P.get("skid.a0_m_s2", 0.3), 0.0)
         lat = -np.sign(ac) * ks * ex * 1e3 * pr.dt
     kc = P.get("skid@cornering.deg_per_m_s2", 0.0) if drive else 0.0
     if kc > 0:
         lat = lat + skid_cornering(pr, ds, bt, g, kc)
     return ds, bt, lat, g
+
+
+def centripetal(pr: Prepared, ds: np.ndarray, bt: float, g: np.ndarray | None) -> np.ndarray:
+    """(n-1,) each tick's centripetal acceleration v omega (m/s^2, + turning left) from the
+    floor travel ds on wheelbase bt, the heading change scaled by g (scrub) when there is one."""
+    v = 0.5 * (ds[:, 0] + ds[:, 1]) / pr.dt
+    om = (ds[:, 1] - ds[:, 0]) / bt / pr.dt * (1.0 if g is None else g)
+    return v * om * 1e-3
 
 
 def skid_cornering(
@@ -241,10 +247,8 @@ def skid_cornering(
     threshold), so a tick of forward travel d also moves d tan(beta) outward. The catalog's skid
     starts only above a0: a robot whose fast circle skidded was judged on a slower one where
     that law gives nothing (independent world, seed 2721 case 28)."""
-    d = 0.5 * (ds[:, 0] + ds[:, 1])
-    om = (ds[:, 1] - ds[:, 0]) / bt / pr.dt * (1.0 if g is None else g)
-    beta = np.radians(kc) * (d / pr.dt) * om * 1e-3
-    return -d * np.tan(np.clip(beta, -0.5, 0.5))
+    beta = np.radians(kc) * centripetal(pr, ds, bt, g)
+    return -0.5 * (ds[:, 0] + ds[:, 1]) * np.tan(np.clip(beta, -0.5, 0.5))
 
 
 def scrub_factor(ds: np.ndarray, k: float) -> np.ndarray | None:
