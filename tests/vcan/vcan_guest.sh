@@ -6,8 +6,8 @@
 # offline replay's output frames, host build), REPLAY = odo-replay binary, IF = vcan interface to
 # create. Prints progress lines "vcan: ..." and exactly one verdict line:
 #   ODO-VCAN-VERDICT: PASS frames=N ticks=M ...      or      ODO-VCAN-VERDICT: FAIL <reason>
-# (FAIL-TIMING: outputs differed and some input frame reached the bus more than half a period
-# late, beyond what the replay's tick clock accepts: the emulator was starved, not the code wrong)
+# (FAIL-TIMING: a sensor frame reached the bus more than half a period late and the capture lost
+# frames or the live tick timer passed one: the emulator was starved, not the code wrong)
 set -u
 D=${D:-/test}
 REPLAY=${REPLAY:-/bin/odo-replay}
@@ -71,35 +71,49 @@ wait "$CANDUMP" 2>/dev/null
 wait "$CANDUMP2" 2>/dev/null
 
 # How late the kernel stamped each sensor frame against the log's timing (first frame = 0): the
-# replay accepts up to half a period (20 ms); beyond that an overloaded emulator, not the code,
-# moved a frame to another tick, and the verdict says FAIL-TIMING (vcan_qemu.sh retries once).
+# replay accepts up to half a period (20 ms). Beyond that a starved emulator, not the code, moved
+# frames to other ticks; the live replay must then equal the offline replay of the traffic as the
+# kernel stamped it (sensors.log: the same SO_TIMESTAMP odo-replay reads), which holds however
+# slow the guest is. Only a capture that lost frames, or a frame the live tick timer had already
+# passed, says FAIL-TIMING (vcan_qemu.sh runs the guest once more).
 jitter=$(awk 'NR == FNR { a[FNR] = substr($1, 2, length($1) - 2); next }
     { b = substr($1, 2, length($1) - 2); if (FNR == 1) { a0 = a[1]; b0 = b }
       d = (b - b0) - (a[FNR] - a0); if (d < 0) d = -d; if (d > m) m = d }
     END { printf "%.1f", m * 1000 }' "$D/in.log" "$W/sensors.log")
 echo "vcan: largest bus delay of a sensor frame vs the log's timing: $jitter ms"
-timing_fail() {
-    if awk -v j="$jitter" 'BEGIN { exit !(j > 20) }'; then
-        echo "ODO-VCAN-VERDICT: FAIL-TIMING $* (a frame was delayed $jitter ms > 20 ms)"
-        exit 1
-    fi
-    fail "$*"
-}
 awk '{print $3}' "$W/bus.log" >"$W/bus.txt"
 awk '{print $3}' "$W/live/out.log" >"$W/live.txt"
 frames=$(wc -l <"$D/expected.txt" | tr -d ' ')
 bus=$(wc -l <"$W/bus.txt" | tr -d ' ')
 [ "$frames" -gt 0 ] || fail "no expected frames"
-if ! cmp -s "$W/bus.txt" "$D/expected.txt"; then
-    echo "vcan: first differences (expected vs bus):"
-    diff "$D/expected.txt" "$W/bus.txt" | head -20
-    echo "vcan: first sensor frames as the kernel stamped them:"
-    head -12 "$W/sensors.log"
-    echo "vcan: live summary $(cat "$W/live/summary.json")"
-    timing_fail "bus frames differ from the offline replay ($bus vs $frames frames)"
+ref="$D/expected.txt"
+ref_poses="$W/offline/poses.csv"
+if awk -v j="$jitter" 'BEGIN { exit !(j > 20) }'; then
+    awk '{print $3}' "$D/in.log" >"$W/sent.txt"
+    awk '{print $3}' "$W/sensors.log" >"$W/seen.txt"
+    if ! cmp -s "$W/sent.txt" "$W/seen.txt" || ! grep -q '"late": 0,' "$W/live/summary.json"; then
+        # a lost capture, or a frame after the live tick timer had closed its tick (offline has
+        # no timer): the starved emulator decided, nothing left to compare against
+        echo "ODO-VCAN-VERDICT: FAIL-TIMING frames lost or late while one was delayed $jitter ms"
+        exit 1
+    fi
+    "$REPLAY" --log "$W/sensors.log" --robot "$D/robot.json" --out "$W/bustimed" --quiet ||
+        fail "offline replay of the captured bus failed"
+    awk '{print $3}' "$W/bustimed/out.log" >"$W/bustimed.txt"
+    ref="$W/bustimed.txt"
+    ref_poses="$W/bustimed/poses.csv"
+    echo "vcan: frames delayed beyond half a period: judged against the offline replay of the bus as the kernel stamped it"
 fi
-cmp -s "$W/live.txt" "$D/expected.txt" || timing_fail "live out.log differs from the offline replay"
-cmp -s "$W/live/poses.csv" "$W/offline/poses.csv" || timing_fail "live poses.csv differs from the offline one"
+if ! cmp -s "$W/bus.txt" "$ref"; then
+    echo "vcan: first differences (expected vs bus):"
+    diff "$ref" "$W/bus.txt" | head -20 | sed 's/^/vcan:   /'
+    echo "vcan: first sensor frames as the kernel stamped them:"
+    head -12 "$W/sensors.log" | sed 's/^/vcan:   /'
+    echo "vcan: live summary $(cat "$W/live/summary.json")"
+    fail "bus frames differ from the offline replay ($bus vs $(wc -l <"$ref" | tr -d ' ') frames)"
+fi
+cmp -s "$W/live.txt" "$ref" || fail "live out.log differs from the offline replay"
+cmp -s "$W/live/poses.csv" "$ref_poses" || fail "live poses.csv differs from the offline one"
 ticks=$(($(wc -l <"$W/offline/poses.csv") - 1))
 echo "vcan: live summary $(cat "$W/live/summary.json")"
 
