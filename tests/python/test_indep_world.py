@@ -127,6 +127,30 @@ def test_drawn_cases_follow_the_mix_and_every_case_has_a_floor() -> None:
         assert got == set(laws_) and len(laws_) >= 2, (e, got)
 
 
+def test_a_friction_circle_skid_acts_on_the_hardest_turns_and_not_on_starts() -> None:
+    """The floor's limit lies below the lateral acceleration the plan's hardest turn asks and
+    above the planner's starts and stops (by cases.FRICTION_START) and ice (FRICTION_MIN), and
+    no run outlasts the time bound. A clapper's tightest arcs are gentle (its linkage): a floor
+    taken above them never skidded at all (seed 2731 case 43); where no floor but ice lies
+    below its turns, the skid is the cornering law's."""
+    rng = np.random.default_rng(7)
+    seen = set()
+    for k in range(400):
+        c = indep.draw_case(rng, k)
+        e = c["true"]["effects"].get("skid")
+        if not e or e["law"] != "friction":
+            continue
+        seen.add(c["vehicle"])
+        a_lim = e["a_lim_m_s2"] * 1000
+        ctl = c["controller"]
+        assert max(ctl["a_mm_s2"], ctl["d_mm_s2"]) * cases.FRICTION_START <= a_lim * (1 + 1e-9)
+        assert cases.FRICTION_MIN <= a_lim < 0.9 * cases._peak_plan(c)[1]
+        for run in c["plan"]:
+            lim = cases.limits(c, run)
+            assert cases._duration(run["segs"], lim) <= cases._max_run_s(c["robot"]) + 1e-6
+    assert "labmate" in seen and len(seen) >= 2, seen
+
+
 def test_drawn_robots_pass_the_repos_robot_validator() -> None:
     """robot.json is the nominal description the firmware believes: libodosim must accept it."""
     import ctypes as C

@@ -244,6 +244,22 @@ def _fit(segs: list, lim: paths.Limits, max_s: float, rmin: float) -> list:
     return segs
 
 
+def _rmin(rob: dict) -> float:
+    """The tightest arc radius the plan drives (mm): what the vehicle's linkage or trailer and
+    its wheelbase allow."""
+    if rob["vehicle"] == "clapper":
+        rmin = 0.8 * rob["linkage"]["length_mm"]
+    elif rob["vehicle"] == "set":
+        rmin = 1.2 * (rob["trailer"]["hitch_offset_mm"] + rob["trailer"]["trailer_length_mm"])
+    else:
+        rmin = 0.75 * rob["trucks"]["A"]["wheelbase_mm"]
+    return max(rmin, 300.0)
+
+
+def _max_run_s(rob: dict) -> float:
+    return min(50.0, max(30.0, 2500 * rob["tick_ms"] / 1000))
+
+
 def draw_plan(rng: np.random.Generator, case: dict, effects: list[str]) -> list[dict]:
     """6-13 runs of several shapes; UMBmark squares in both directions always among them (a
     case with count loss drives its sprint twice). A run lasts at most max(30 s, 2500 control
@@ -252,13 +268,7 @@ def draw_plan(rng: np.random.Generator, case: dict, effects: list[str]) -> list[
     veh = rob["vehicle"]
     b = rob["trucks"]["A"]["wheelbase_mm"]
     side = float(np.clip(round(rng.uniform(6, 14) * b, -2), 1000, 5000))
-    if veh == "clapper":
-        rmin = 0.8 * rob["linkage"]["length_mm"]
-    elif veh == "set":
-        rmin = 1.2 * (rob["trailer"]["hitch_offset_mm"] + rob["trailer"]["trailer_length_mm"])
-    else:
-        rmin = 0.75 * b
-    rmin = max(rmin, 300.0)
+    rmin = _rmin(rob)
     corner = 0.0 if veh == "labmate" else _r(min(rng.uniform(1.0, 1.6) * rmin, side / 2.5))
     if corner:
         side = max(side, _r(2.6 * corner))
@@ -317,7 +327,7 @@ def draw_plan(rng: np.random.Generator, case: dict, effects: list[str]) -> list[
             0.85 * rob["max_wheel_speed_mm_s"]))}
         sprint["segs"] = paths.shuttle(L) if veh == "labmate" else [("line", L)]
         plan[-1] = sprint
-    max_s = min(50.0, max(30.0, 2500 * rob["tick_ms"] / 1000))
+    max_s = _max_run_s(rob)
     for p in plan:
         p["segs"] = _fit(p["segs"], limits(case, p), max_s, rmin)
     order = rng.permutation(len(plan))
@@ -394,6 +404,10 @@ def _cables(rng, case: dict, law: str) -> list[dict]:
     return out
 
 
+FRICTION_START = 1.25  # a friction-circle floor gives starts and stops this margin at least
+FRICTION_MIN = 200.0  # mm/s^2: the least grip a floor that is not ice gives (mu 0.02)
+
+
 def draw_effect(rng, name: str, case: dict) -> tuple[dict, dict]:
     """One effect: (true law parameters, catalog-equivalent params)."""
     rob = case["robot"]
@@ -447,11 +461,26 @@ def draw_effect(rng, name: str, case: dict) -> tuple[dict, dict]:
             e["a_lim_m_s2"] = _f(rng.uniform(0.7, 0.95) * ctl["a_mm_s2"] / 1000)
     elif name == "skid":
         alat = _peak_plan(case)[1]  # the hardest turn of the plan, mm/s^2
+        u = rng.uniform()  # one draw either law (the cases after this one stay as they were)
+        a_lim = (0.6 + 0.25 * u) * alat
+        if law == "friction" and a_lim < FRICTION_MIN:
+            # no floor short of ice lies below this plan's turns (a set's or clapper's wide
+            # arcs): its tyres' cornering stiffness is what skids there
+            law = e["law"] = "cornering"
         if law == "friction":  # the hardest turns ask for more than the floor gives; starts do not
-            a_long = max(ctl["a_mm_s2"], ctl["d_mm_s2"]) * 1.25
-            e["a_lim_m_s2"] = _f(max(a_long, rng.uniform(0.6, 0.85) * alat) / 1000)
+            e["a_lim_m_s2"] = _f(a_lim / 1000)
+            a_long = max(ctl["a_mm_s2"], ctl["d_mm_s2"])
+            if a_long * FRICTION_START > a_lim:
+                # a plan whose tightest arcs are gentle (a clapper's long linkage) gets gentler
+                # starts and stops, and its runs are shortened again to the time bound. Taking
+                # the larger of the two instead left the floor above every turn: a skid that
+                # never acted (seed 2731 case 43)
+                f = a_lim / (a_long * FRICTION_START)
+                ctl["a_mm_s2"], ctl["d_mm_s2"] = _f(ctl["a_mm_s2"] * f), _f(ctl["d_mm_s2"] * f)
+                for run in case["plan"]:
+                    run["segs"] = _fit(run["segs"], limits(case, run), _max_run_s(rob), _rmin(rob))
         else:
-            e["c_alpha_m_s2"] = _f(alat / 1000 / math.radians(rng.uniform(1, 5)))
+            e["c_alpha_m_s2"] = _f(alat / 1000 / math.radians(1 + 4 * u))
     elif name == "count_loss":
         # the fastest any wheel of the truck runs in the plan (edges/s): one wheel losing a
         # per cent of its counts in a turn costs degrees, so the losses are kept to the peaks
