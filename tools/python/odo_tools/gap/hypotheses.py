@@ -35,6 +35,8 @@ EXTRA_BOUNDS = {
     "slip@accel.a0_m_s2": (0.0, 5.0, 0.2),
     "slip@accel.asym": (-0.9, 0.9, 0.0),
     "slip@traction.a_max_m_s2": (0.05, 20.0, 2.0),
+    "slip@motor.a_max_m_s2": (0.05, 20.0, 1.0),
+    "slip@motor.tau_s": (0.002, 0.2, 0.03),
     "count_loss@speed.k_per_m_s": (0.0, 20.0, 0.2),
     "count_loss@speed.v0_mm_s": (0.0, 5000.0, 300.0),
     "count_loss@plateau.excess_mm_s": (0.0, 5000.0, 400.0),
@@ -89,6 +91,13 @@ OTHER_LAWS = {
             ("slip@traction.a_max_m_s2",),
             "traction (torque) saturation: the floor speed follows the wheel at most by what "
             "the friction circle of a_max leaves beside the turn's lateral acceleration",
+        ),
+        Law(
+            "slip",
+            "motor",
+            ("slip@motor.a_max_m_s2", "slip@motor.tau_s"),
+            "traction saturation inside the tick: the motor reaches each tick's speed with a "
+            "lag tau, and the floor follows it at most by the friction circle of a_max",
         ),
     ),
     "skid": (

@@ -11,6 +11,7 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
+from scipy.signal import lfilter
 
 from .io import Robot, RunData
 
@@ -199,6 +200,8 @@ def floor_travel(
         ds = slip_accel(pr, ds, P)
     if drive and P.get("slip@traction.a_max_m_s2", 0.0) > 0:
         ds = slip_traction(pr, ds, P["slip@traction.a_max_m_s2"], b)
+    if drive and P.get("slip@motor.a_max_m_s2", 0.0) > 0:
+        ds = slip_motor(pr, ds, P["slip@motor.a_max_m_s2"], P.get("slip@motor.tau_s", 0.02), b)
     if P.get("count_loss@speed.k_per_m_s", 0.0) > 0:
         ds = count_loss_speed(pr, ds, truck, P)
     if P.get("count_loss@plateau.level_mm_s", 0.0) > 0:
@@ -307,6 +310,59 @@ def slip_traction(pr: Prepared, ds: np.ndarray, a_max: float, b: float) -> np.nd
     for w in (0, 1):
         u[:, w] = _rate_limit(v[:, w], lim)
     return u * pr.dt[:, None]
+
+
+MOTOR_STEP_S = 0.002  # the longest sub-step of the motor's speed inside a tick
+
+
+def motor_substeps(T: float) -> int:
+    return max(4, math.ceil(T / MOTOR_STEP_S - 1e-9))
+
+
+def motor_profile(m: np.ndarray, T: float, tau: float) -> np.ndarray:
+    """(n, S) wheel speed at the ends of S = motor_substeps(T) equal sub-steps of each tick, for
+    a speed-commanded motor: a new target every tick, approached with the first-order lag tau
+    from the speed the last tick ended at (0 before the first), the target chosen so that the
+    exact mean over the tick is the counted mean m (n,). The tick's end speed then obeys
+    w_i = a m_i + c w_(i-1), a first-order filter of the counted speeds."""
+    E = math.exp(-T / tau)
+    g = tau / T * (1.0 - E)  # share of the step the tick's mean still lacks
+    a = (1.0 - E) / (1.0 - g)
+    c = E - (1.0 - E) * g / (1.0 - g)
+    w_end = lfilter([a], [1.0, -c], m)
+    w0 = np.concatenate([[0.0], w_end[:-1]])
+    target = (m - w0 * g) / (1.0 - g)
+    S = motor_substeps(T)
+    ts = np.arange(1, S + 1) / S * T
+    return target[:, None] + (w0 - target)[:, None] * np.exp(-ts / tau)[None, :]
+
+
+def slip_motor(pr: Prepared, ds: np.ndarray, a_max: float, tau: float, b: float) -> np.ndarray:
+    """Traction saturation inside the tick: a speed-commanded motor steps its target once per
+    tick and reaches it with a lag tau, so its acceleration comes in bursts of (step / tau) at
+    the start of each tick, not the tick's mean step / T. The floor speed follows the wheel at
+    most by the friction circle's sqrt(a_max^2 - (v w)^2) (as slip_traction), sub-step by
+    sub-step; what the wheel ran ahead of (or behind) the floor, trapezoid by trapezoid, is the
+    tick's slip (none where the floor keeps up). A tick-level limiter sees only the mean and
+    misses the bursts: the independent world's traction slip on 100 ms ticks with an 18 ms
+    motor (seed 2731 case 24) left the held-out runs at 13 x the background under
+    slip_traction."""
+    v = _wheel_speeds(pr, ds)
+    T = float(np.median(pr.dt))
+    S = motor_substeps(T)
+    h = T / S
+    prof = [motor_profile(v[:, w], T, tau) for w in (0, 1)]
+    a = a_max * 1e3
+    alat = np.abs(0.5 * (prof[0] + prof[1]) * (prof[1] - prof[0]) / b)
+    lim = (np.sqrt(np.maximum(a * a - alat * alat, (0.1 * a) ** 2)) * h).ravel()
+    out = ds.copy()
+    for w in (0, 1):
+        wheel = prof[w].ravel()
+        floor = _rate_limit(wheel, lim)
+        ahead = wheel - floor
+        lost = 0.5 * (ahead + np.concatenate([[0.0], ahead[:-1]])) * h
+        out[:, w] -= lost.reshape(-1, S).sum(axis=1)
+    return out
 
 
 def _rate_limit(v: np.ndarray, lim: np.ndarray) -> np.ndarray:

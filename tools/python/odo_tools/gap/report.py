@@ -41,7 +41,11 @@ LAW_WORDS = {
     "one grip per tyre",
     "traction": "traction (torque) saturation: the floor speed changes by at most what the "
     "friction circle of a_max leaves beside the turn",
+    "motor": "traction saturation inside the tick: the motor takes each tick's speed with a lag "
+    "tau, and the floor follows it by at most a_max",
     "speed": "a fraction of the counts lost above a wheel speed",
+    "plateau": "a count-rate ceiling: the counts sit on a flat top while the hidden wheel speed "
+    "rises beyond it and back",
     "cornering": "linear cornering stiffness: the tyres run at a slip angle proportional to the "
     "centripetal acceleration, from the gentlest arc up (no threshold)",
 }
@@ -72,6 +76,8 @@ def unit(key: str) -> str:
             "k_per_m_s": "1/(m/s)",
             "v0_mm_s": "mm/s",
             "deg_per_m_s2": "deg/(m/s^2)",
+            "excess_mm_s": "mm/s",
+            "a_m_s2": "m/s^2",
         }.get(p, "")
     return "" if u in ("1", "-") else u
 
