@@ -62,7 +62,8 @@ def test_bursts_spin_where_the_tick_mean_grips() -> None:
     more than the floor gives, so slip_traction loses nothing; a 5 ms motor takes each 50 mm/s
     step in a burst of 10 m/s^2 and spins on every step, the floor catching up at 0.8 m/s^2
     after t = dv / a: the wheel runs dv (t - tau) ahead of a floor that covers a t^2 / 2 of
-    the step, 1.31 mm per step, 40 steps. Once the speed holds, the floor has caught up."""
+    the step, 1.31 mm per step, 40 steps (the model's 10 ms sub-steps resolve the 5 ms burst
+    to within a few per cent). Once the speed holds, the floor has caught up."""
     from odo_tools.gap.model import slip_motor, slip_traction
 
     T, dv, a = 0.1, 50.0, 0.8
@@ -73,7 +74,7 @@ def test_bursts_spin_where_the_tick_mean_grips() -> None:
     lost = ds.sum(axis=0) - got.sum(axis=0)
     tau, t = 0.005, dv / (a * 1e3)
     want = 40 * (dv * (t - tau) - a * 1e3 * t * t / 2)
-    assert lost == pytest.approx([want, want], rel=0.02)
+    assert lost == pytest.approx([want, want], rel=0.06)
     assert np.allclose(got[-5:], ds[-5:])
     # a floor that grips the bursts too loses nothing
     assert np.allclose(slip_motor(pr, ds, 50.0, 0.005, b), ds, atol=1e-9)
@@ -105,3 +106,25 @@ def test_every_other_law_has_words_and_units_in_the_report() -> None:
             assert law.name in report.LAW_WORDS, law.key
             for p in law.params:
                 assert report.unit(p) != "" or p.endswith((".asym",)), p
+
+
+def test_a_truth_late_behind_slipping_counts_finds_its_clock(tmp_path: Path) -> None:
+    """Independent world, seed 2721 case 45: a set's traction slip (0.91 m/s^2) under a
+    motion capture 33 ms late. Read before any effect, the latencies held the slip too, and
+    without them (the only other choice then) the slip fitted to the wrong clock left the
+    held-out runs at 13 x the background, "unexplained". One clock for every run tried under the
+    slip candidate finds the rig's latency and the floor's grip; slip is named."""
+    import statistics
+
+    from odo_tools.gap.diagnose import diagnose
+
+    real = tmp_path / "real"
+    c = indep_case(2721, 45, real, "set", {"slip": "traction"})
+    rep = diagnose(real, real / "robot.json", mode="truth").to_dict()
+    v = rep["verdict"]
+    assert v["effect"] == "slip", v
+    true = c["true"]["effects"]["slip"]["a_lim_m_s2"]
+    assert v["params"]["slip@motor.a_max_m_s2"] == pytest.approx(true, rel=0.03)
+    lat = statistics.median(rep["instrument"]["latency_s"].values())
+    assert lat == pytest.approx(c["fidelity"]["truth_latency_s"], abs=0.008)
+    assert rep["heldout"]["ratio_after"] < 0.5 * rep["heldout"]["ratio_before"]

@@ -396,7 +396,8 @@ def _more(base: Fit, more: Fit, prob: Problem, ds: Dataset, sel: Selection) -> b
     if base.hyp is not None and more.hyp is not None:
         added = set(more.hyp.families) - set(base.hyp.families)
         lever = sum(math.hypot(*o) for o in ds.instrument.lever_mm) if ds.instrument else 0.0
-        if added & _below_resolution(more, ds.robot, lever):
+        head = math.hypot(*ds.instrument.heading_offset_se_rad[:2]) if ds.instrument else 0.0
+        if added & _below_resolution(more, ds.robot, lever, math.degrees(head)):
             return False
     c = max(1.0, base.chi / max(prob.e0 - base.k, 1))
     if ds.mode != "truth":
@@ -416,7 +417,9 @@ def _more(base: Fit, more: Fit, prob: Problem, ds: Dataset, sel: Selection) -> b
     return r_more * TRACK_GAIN <= r_base
 
 
-def _below_resolution(f: Fit, robot: Robot, lever_mm: float = 0.0) -> set[str]:
+def _below_resolution(
+    f: Fit, robot: Robot, lever_mm: float = 0.0, head_se_deg: float = 0.0
+) -> set[str]:
     """The linkage-bias members of f whose fitted size is within half a step of the encoder
     they bias. A lever arm or heading offset of the truth estimated a few mm or a tenth of a
     degree off moves the true linkage derived from it by as much, and thousands of readings make
@@ -426,11 +429,15 @@ def _below_resolution(f: Fit, robot: Robot, lever_mm: float = 0.0) -> set[str]:
     link-length bias within `lever_mm`, the lever arms taken off the trucks' tracked points
     (summed): the link length the truth derives from them moves by as much when they are off
     (independent seed 2691 case 50: a 2.1 mm lever arm estimated on a truck that has none, and
-    a 1.25 mm link bias beside the trailer's Es)."""
+    a 1.25 mm link bias beside the trailer's Es); nor a rotary bias within twice `head_se_deg`,
+    the standard error of the two trucks' truth heading offsets' difference, which the truth's
+    joint angle carries (independent seed 2731 case 16: one rig's 0.205 deg read as 0.194 and
+    0.211 deg on a set's two trucks, and a 0.016 deg rotary bias, above half the 14-bit
+    encoder's 0.022 deg step, joined its slip)."""
     lk = robot.linkage or robot.trailer or {}
     bits = lk.get("rotary_bits")
     steps = {  # the encoder step each bias is read in (deg, mm)
-        "rotary_bias": 360.0 / (1 << int(bits)) if bits else None,
+        "rotary_bias": max(360.0 / (1 << int(bits)) if bits else 0.0, 4.0 * head_se_deg) or None,
         "link_bias": max(lk.get("linear_resolution_mm") or 0.0, 2.0 * lever_mm) or None,
     }
     out = set()
@@ -774,13 +781,23 @@ def _relatency(ds: Dataset, sel: Selection, rk: Ranking) -> bool:
 SLIP_EARLY = 3  # a slip single this high among the singles is asked about latency at once
 
 
+# the one clock a truth may run behind the counts by, tried under a slip candidate; the
+# latencies read before any effect are slip's as much as the clock's (independent world: 75 ms
+# read for a 27 ms truth under traction slip, seed 2731 case 24), and without them the slip
+# fitted to a truth 27-40 ms late left its held-out runs at 13 x the background (2721 case 45:
+# at its true 33 ms, slip at 1.4 x)
+SLIP_CLOCK_S = (0.0, 0.015, 0.03, 0.05)
+SLIP_CLOCK_REFINE_S = 0.0075
+
+
 def _slip_not_latency(
     ds: Dataset, sel: Selection, ranked: Problem, best: Fit, cand: Fit | None = None
 ) -> bool:
     """The converse of `_relatency`: runs given a latency - is the latency the robot's slip?
-    The best candidate (plus catalog slip when it has none) is fitted on the items without
-    latency; if that explains the fitting runs better (each latency one parameter), the
-    latencies go and the ranking runs again (True). The blind check's simulator has no
+    The best candidate (plus catalog slip when it has none) is fitted on the items with one
+    clock for every run instead, each of SLIP_CLOCK_S (none among them) and around the best;
+    if the best of those explains the fitting runs better (each latency read one parameter, the
+    clock one), it replaces the latencies and the ranking runs again (True). The blind check's simulator has no
     latency, but its slip on rect-7x4's faster starts read as 25 ms, and scrub took the rest.
     A candidate with slip is asked too: the instrument's latency is fitted before any effect,
     and a truck that spins on every start lags its counts like a late truth (independent world,
@@ -794,21 +811,37 @@ def _slip_not_latency(
     lat = [pr for pr in fprs if abs(ds.instrument.latency_s.get(pr.run.name, 0.0)) > 0]
     if not lat:
         return False
-    inst = ds.instrument.copy()
-    inst.latency_s = {k: 0.0 for k in ds.instrument.latency_s}
-    items = [TruthMode(pr, ds.robot, inst) for pr in ds.prs]
-    prob = Problem("truth", [items[i] for i in sel.fit], ranked.sigma)
-    prob.set_background(ranked.walk, ranked.sigma)
     ask = cand if cand is not None else best
     hyp = ask.hyp
     if "slip" not in hyp.families:
         hyp = hyp + next(
             h for h in hypotheses.singles("truth", ds.robot.vehicle) if h.name == "slip"
         )
-    alt = fit_hypothesis(
-        hyp, prob, fprs, _sig_head(prob, items[0].channels()), warm=ask.model_params()
-    )
-    if alt.bic >= best.bic - len(lat) * math.log(max(best.n, 2)):
+
+    def under_clock(L: float) -> tuple[Fit, Instrument, list, float]:
+        inst = ds.instrument.copy()
+        inst.latency_s = {k: L for k in ds.instrument.latency_s}
+        items = [TruthMode(pr, ds.robot, inst) for pr in ds.prs]
+        prob = Problem("truth", [items[i] for i in sel.fit], ranked.sigma)
+        prob.set_background(ranked.walk, ranked.sigma)
+        f = fit_hypothesis(
+            hyp, prob, fprs, _sig_head(prob, items[0].channels()), warm=ask.model_params()
+        )
+        # a clock other than none is one parameter
+        return f, inst, items, f.bic + (math.log(max(f.n, 2)) if L else 0.0)
+
+    # the clock is looked for once (each point a fit); asked again (after the ranking, with
+    # the best candidate), only whether the latencies are the slip
+    grid = (0.0,) if ds.instrument.clock_scanned else SLIP_CLOCK_S
+    ds.instrument.clock_scanned = True
+    tried = {L: under_clock(L) for L in grid}
+    top = min(tried, key=lambda L: tried[L][3])
+    if top:
+        for L in (top - SLIP_CLOCK_REFINE_S, top + SLIP_CLOCK_REFINE_S):
+            tried[L] = under_clock(L)
+        top = min(tried, key=lambda L: tried[L][3])
+    _, inst, items, cost = tried[top]
+    if cost >= best.bic - len(lat) * math.log(max(best.n, 2)):
         return False
     ds.instrument = inst
     ds.items = items

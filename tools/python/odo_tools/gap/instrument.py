@@ -48,10 +48,13 @@ def estimate(prs: list[Prepared], trucks: int) -> tuple[Instrument, list[str]]:
         lever_mm=[(0.0, 0.0)] * trucks,
         lever_se_mm=[(0.0, 0.0)] * trucks,
         heading_offset_rad=[0.0] * trucks,
+        heading_offset_se_rad=[0.0] * trucks,
     )
     with_truth = [pr for pr in prs if pr.run.truth is not None]
     for t in range(trucks):
         o, se, n = heading_offset(with_truth, t)
+        if o is not None:
+            inst.heading_offset_se_rad[t] = se
         if o is not None and abs(o) >= HEADING_OFFSET_SIGNIFICANT * se:
             inst.heading_offset_rad[t] = o
     for _ in range(2):

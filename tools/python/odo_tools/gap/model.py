@@ -312,7 +312,7 @@ def slip_traction(pr: Prepared, ds: np.ndarray, a_max: float, b: float) -> np.nd
     return u * pr.dt[:, None]
 
 
-MOTOR_STEP_S = 0.002  # the longest sub-step of the motor's speed inside a tick
+MOTOR_STEP_S = 0.01  # the longest sub-step of the motor's speed inside a tick
 
 
 def motor_substeps(T: float) -> int:
@@ -369,28 +369,35 @@ def _rate_limit(v: np.ndarray, lim: np.ndarray) -> np.ndarray:
     """u_i = u_(i-1) + clip(v_i - u_(i-1), -lim_i, lim_i) from u = 0, as a per-tick loop would
     compute it, bit for bit. Sequential only where the limit bites: while the output equals the
     input (u_(i-1) == v_(i-1)) and the next step is within the limit and lands exactly on v_i,
-    a stretch is copied; elsewhere one tick at a time over Python floats."""
+    a stretch is copied; elsewhere one tick at a time over Python floats, from the first tick
+    that is not a plain copy (before it the output is the input)."""
     n = v.size
     prev = np.concatenate([[0.0], v[:-1]])
     d = v - prev
     fast = ~(d > lim) & ~(d < -lim) & (prev + d == v)  # what a step from u = v_(i-1) gives
-    stop = [*np.flatnonzero(~fast).tolist(), n]  # ticks the loop must take one by one
-    vl, ll, pl = v.tolist(), lim.tolist(), prev.tolist()
-    out = np.empty(n)
-    cur, i, k = 0.0, 0, 0
-    while i < n:
-        if cur == pl[i]:  # tracking: jump to the next tick that is not a plain copy
+    slow = np.flatnonzero(~fast)
+    out = v.copy()
+    if slow.size == 0:
+        return out
+    i0 = int(slow[0])
+    stop = [*(slow - i0).tolist(), n - i0]  # ticks the loop must take one by one
+    vl, ll = v[i0:].tolist(), lim[i0:].tolist()
+    m = n - i0
+    cur = float(prev[i0])  # the output so far is the input
+    i, k = 0, 0
+    while i < m:
+        if cur == (vl[i - 1] if i else float(prev[i0])):  # tracking: jump to the next slow tick
             while stop[k] < i:
                 k += 1
             j = stop[k]
             if j > i:
-                out[i:j] = v[i:j]
                 cur, i = vl[j - 1], j
-                if i == n:
+                if i == m:
                     break
+                continue
         dd, li = vl[i] - cur, ll[i]
         cur = cur + (li if dd > li else (-li if dd < -li else dd))
-        out[i] = cur
+        out[i0 + i] = cur
         i += 1
     return out
 

@@ -172,11 +172,16 @@ class Instrument:
     latency_s: dict[str, float] = field(default_factory=dict)
     # per truck: the marker body's heading against the truck's (rad; measured = true + offset)
     heading_offset_rad: list[float] = field(default_factory=lambda: [0.0, 0.0])
+    # per truck: the standard error of that offset (rad; 0 where it was not measured)
+    heading_offset_se_rad: list[float] = field(default_factory=lambda: [0.0, 0.0])
+    # one clock for every run was looked for under a slip candidate (diagnose._slip_not_latency)
+    clock_scanned: bool = False
 
     def copy(self) -> Instrument:
         return Instrument(
             list(self.lever_mm), list(self.lever_se_mm), dict(self.latency_s),
-            list(self.heading_offset_rad),
+            list(self.heading_offset_rad), list(self.heading_offset_se_rad),
+            self.clock_scanned,
         )  # fmt: skip
 
 
