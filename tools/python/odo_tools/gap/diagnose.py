@@ -797,8 +797,9 @@ def _slip_not_latency(
     The best candidate (plus catalog slip when it has none) is fitted on the items with one
     clock for every run instead, each of SLIP_CLOCK_S (none among them) and around the best;
     if the best of those explains the fitting runs better (each latency read one parameter, the
-    clock one), it replaces the latencies and the ranking runs again (True). The blind check's simulator has no
-    latency, but its slip on rect-7x4's faster starts read as 25 ms, and scrub took the rest.
+    clock one), it replaces the latencies and the ranking runs again (True). The blind check's
+    simulator has no latency, but its slip on rect-7x4's faster starts read as 25 ms, and scrub
+    took the rest.
     A candidate with slip is asked too: the instrument's latency is fitted before any effect,
     and a truck that spins on every start lags its counts like a late truth (independent world,
     seed 2701 case 21: 95-110 ms read for a 20 ms truth, and the traction law then left the
