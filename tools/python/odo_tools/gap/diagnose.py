@@ -786,8 +786,8 @@ SLIP_EARLY = 3  # a slip single this high among the singles is asked about laten
 # read for a 27 ms truth under traction slip, seed 2731 case 24), and without them the slip
 # fitted to a truth 27-40 ms late left its held-out runs at 13 x the background (2721 case 45:
 # at its true 33 ms, slip at 1.4 x)
-SLIP_CLOCK_S = (0.0, 0.015, 0.03, 0.05)
-SLIP_CLOCK_REFINE_S = 0.0075
+SLIP_CLOCK_S = (0.0, 0.01, 0.02, 0.03, 0.045, 0.06)
+SLIP_CLOCK_REFINE_S = 0.005
 
 
 def _slip_not_latency(
