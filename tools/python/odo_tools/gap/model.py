@@ -303,13 +303,20 @@ def slip_traction(pr: Prepared, ds: np.ndarray, a_max: float, b: float) -> np.nd
     Without the circle, starts on a 0.75 m/s arc spun far more than the law allowed (independent
     world, seed 2701 case 21: a circle left at 108 mm after the fit)."""
     v = _wheel_speeds(pr, ds)
-    a = a_max * 1e3
-    alat = np.abs(0.5 * (v[:, 0] + v[:, 1]) * (v[:, 1] - v[:, 0]) / b)
-    lim = np.sqrt(np.maximum(a * a - alat * alat, (0.1 * a) ** 2)) * pr.dt  # mm/s per tick
+    lim = _grip(a_max, v[:, 0], v[:, 1], b) * pr.dt  # mm/s per tick
     u = np.empty_like(v)
     for w in (0, 1):
         u[:, w] = _rate_limit(v[:, w], lim)
     return u * pr.dt[:, None]
+
+
+def _grip(a_max: float, vl: np.ndarray, vr: np.ndarray, b: float) -> np.ndarray:
+    """The floor's longitudinal grip (mm/s^2) beside the turn: what the friction circle of a_max
+    (m/s^2) leaves beside the lateral acceleration v w of wheel speeds vl, vr (mm/s) on
+    wheelbase b, at least a tenth of a_max."""
+    a = a_max * 1e3
+    alat = np.abs(0.5 * (vl + vr) * (vr - vl) / b)
+    return np.sqrt(np.maximum(a * a - alat * alat, (0.1 * a) ** 2))
 
 
 MOTOR_STEP_S = 0.01  # the longest sub-step of the motor's speed inside a tick
@@ -352,9 +359,7 @@ def slip_motor(pr: Prepared, ds: np.ndarray, a_max: float, tau: float, b: float)
     S = motor_substeps(T)
     h = T / S
     prof = [motor_profile(v[:, w], T, tau) for w in (0, 1)]
-    a = a_max * 1e3
-    alat = np.abs(0.5 * (prof[0] + prof[1]) * (prof[1] - prof[0]) / b)
-    lim = (np.sqrt(np.maximum(a * a - alat * alat, (0.1 * a) ** 2)) * h).ravel()
+    lim = (_grip(a_max, prof[0], prof[1], b) * h).ravel()
     out = ds.copy()
     for w in (0, 1):
         wheel = prof[w].ravel()
@@ -383,10 +388,10 @@ def _rate_limit(v: np.ndarray, lim: np.ndarray) -> np.ndarray:
     stop = [*(slow - i0).tolist(), n - i0]  # ticks the loop must take one by one
     vl, ll = v[i0:].tolist(), lim[i0:].tolist()
     m = n - i0
-    cur = float(prev[i0])  # the output so far is the input
+    p0 = cur = float(prev[i0])  # the output so far is the input
     i, k = 0, 0
     while i < m:
-        if cur == (vl[i - 1] if i else float(prev[i0])):  # tracking: jump to the next slow tick
+        if cur == (vl[i - 1] if i else p0):  # tracking: jump to the next slow tick
             while stop[k] < i:
                 k += 1
             j = stop[k]
