@@ -8,7 +8,9 @@
 
 #include "effects.h"
 #include "odo_robot.h"
+#include "ratelimit.h"
 #include "sil.h"
+#include "world.h"
 
 struct odosim_setup {
     sim_robot_t robot;
@@ -277,3 +279,19 @@ size_t odosim_sizeof(const char *type_name)
 }
 
 void odosim_free(void *p) { free(p); }
+
+long odosim_link_clamp(const double *rel, size_t n, double lo_mm, double hi_mm, const unsigned char *gate,
+                       double *push)
+{
+    return sim_link_clamp_track(rel, n, lo_mm, hi_mm, gate, push);
+}
+
+int odosim_rate_limit(const double *v, const double *lim, size_t n, double *out)
+{
+    return sim_rate_limit(v, lim, n, out);
+}
+
+int odosim_rate_limit_2d(const double *vx, const double *vy, const double *lim, size_t n, double *ox, double *oy)
+{
+    return sim_rate_limit_2d(vx, vy, lim, n, ox, oy);
+}

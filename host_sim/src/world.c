@@ -455,25 +455,58 @@ static void step_trailer(sim_world_t *w, const sim_pose_t *a0)
     }
 }
 
+bool sim_link_push(double dx, double dy, double lo_mm, double hi_mm, double ux0, double uy0, double *px,
+                   double *py)
+{
+    const double l = hypot(dx, dy);
+    *px = 0.0;
+    *py = 0.0;
+    if (l >= lo_mm && l <= hi_mm) {
+        return false;
+    }
+    const double half = 0.5 * ((l < lo_mm ? lo_mm : hi_mm) - l);
+    *px = half * (l > 0.0 ? dx / l : ux0);
+    *py = half * (l > 0.0 ? dy / l : uy0);
+    return true;
+}
+
+long sim_link_clamp_track(const double *rel, size_t n, double lo_mm, double hi_mm, const unsigned char *gate,
+                          double *push)
+{
+    if (rel == NULL || push == NULL || !isfinite(lo_mm) || !isfinite(hi_mm) || lo_mm > hi_mm) {
+        return -1;
+    }
+    long acted = 0;
+    double ox = 0.0, oy = 0.0; /* A's cumulative move; the link vector moves by twice it */
+    for (size_t i = 0; i < n; ++i) {
+        double px, py;
+        if (i > 0U && (gate == NULL || gate[i] != 0U) &&
+            sim_link_push(rel[2U * i] + 2.0 * ox, rel[2U * i + 1U] + 2.0 * oy, lo_mm, hi_mm, 1.0, 0.0, &px, &py)) {
+            ox += px;
+            oy += py;
+            acted++;
+        }
+        push[2U * i] = ox;
+        push[2U * i + 1U] = oy;
+    }
+    return acted;
+}
+
 /* Clapper: keep l within its mechanical range by moving both trucks equally along the link. */
 static void clamp_link(sim_world_t *w)
 {
     sim_pose_t *a = &w->truck[0].pose, *b = &w->truck[1].pose;
-    const double dx = a->x_mm - b->x_mm, dy = a->y_mm - b->y_mm, l = hypot(dx, dy);
-    const double lo = w->robot.link.min_mm, hi = w->robot.link.max_mm;
-    w->clamped_last = false;
-    if (l >= lo && l <= hi) {
+    double px, py;
+    w->clamped_last = sim_link_push(a->x_mm - b->x_mm, a->y_mm - b->y_mm, w->robot.link.min_mm,
+                                    w->robot.link.max_mm, cos(a->theta_rad), sin(a->theta_rad), &px, &py);
+    if (!w->clamped_last) {
         return;
     }
-    const double target = l < lo ? lo : hi;
-    const double ux = l > 0.0 ? dx / l : cos(a->theta_rad), uy = l > 0.0 ? dy / l : sin(a->theta_rad);
-    const double half = 0.5 * (target - l);
-    a->x_mm += half * ux;
-    a->y_mm += half * uy;
-    b->x_mm -= half * ux;
-    b->y_mm -= half * uy;
+    a->x_mm += px;
+    a->y_mm += py;
+    b->x_mm -= px;
+    b->y_mm -= py;
     w->link_clamps++;
-    w->clamped_last = true;
 }
 
 int sim_world_step(sim_world_t *w, double dt_s, const double wheel_speed_cmd_mm_s[2][2])

@@ -205,4 +205,18 @@ double sim_world_time_s(const sim_world_t *w);
 /// Steps in which the clapper linkage hit a stop.
 unsigned long sim_world_link_clamps(const sim_world_t *w);
 
+/// The clapper's stop: the move of truck A (B moves by its negative) that brings the link vector
+/// A - B = (dx, dy) back to the nearer end of [lo_mm, hi_mm], along the link, or along (ux0, uy0)
+/// where A and B coincide. False with a zero move when the length lies within the range.
+bool sim_link_push(double dx, double dy, double lo_mm, double hi_mm, double ux0, double uy0, double *px,
+                   double *py);
+
+/// The same stop replayed over a whole recorded motion (the diagnosis's model, gap/model.py, asks
+/// for it once per fit step): rel[2 i], rel[2 i + 1] is A - B at tick i as the wheels alone would
+/// move it, gate[i] (NULL: always) whether the stop may act at tick i, and push[2 i], push[2 i + 1]
+/// receives A's cumulative move from the stops up to tick i. Tick 0 is taken as it is. Returns the
+/// number of ticks a stop acted, or -1 on NULL arrays or a range that is not finite and ordered.
+long sim_link_clamp_track(const double *rel, size_t n, double lo_mm, double hi_mm, const unsigned char *gate,
+                          double *push);
+
 #endif

@@ -12,6 +12,7 @@
 #include "effects.h"
 #include "odo/odo_params.h"
 #include "odo_robot.h"
+#include "ratelimit.h"
 #include "world.h"
 
 #ifndef ODOSIM_SOURCE_DIR
@@ -426,6 +427,89 @@ START_TEST(clapper_linkage_geometry_follows_002_eq_10_11_16_and_clamps_at_its_ra
 }
 END_TEST
 
+/* The stop replayed over a recorded motion (what gap/model.py asks libodosim for): A drives 10 mm
+ * a tick away from a standing B on a 1000 mm link with range [900, 1100]; the 200 mm beyond the
+ * end are taken up half by each truck, one stop per tick beyond it. */
+START_TEST(clapper_stop_replayed_over_a_track_pushes_half_way_and_obeys_its_gate)
+{
+    enum { N = 31 };
+    double rel[2 * N], push[2 * N];
+    unsigned char gate[N];
+    for (size_t i = 0; i < N; ++i) {
+        rel[2 * i] = 1000.0 + 10.0 * (double)i;
+        rel[2 * i + 1] = 0.0;
+        gate[i] = 1U;
+    }
+    ck_assert_int_eq(sim_link_clamp_track(rel, N, 900.0, 1100.0, NULL, push), 20);
+    ck_assert_double_eq(push[2 * 10], 0.0); /* at 1100 mm: still inside */
+    ck_assert_double_eq_tol(push[2 * 11], -5.0, 1e-12);
+    ck_assert_double_eq_tol(push[2 * (N - 1)], -100.0, 1e-9);
+    ck_assert_double_eq_tol(rel[2 * (N - 1)] + 2.0 * push[2 * (N - 1)], 1100.0, 1e-9);
+    ck_assert_double_eq(push[2 * (N - 1) + 1], 0.0);
+    /* a tick whose gate is closed lets the link run past the stop; the next open one takes it back */
+    gate[11] = gate[12] = 0U;
+    ck_assert_int_eq(sim_link_clamp_track(rel, N, 900.0, 1100.0, gate, push), 18);
+    ck_assert_double_eq(push[2 * 12], 0.0);
+    ck_assert_double_eq_tol(push[2 * 13], -15.0, 1e-12);
+    ck_assert_double_eq_tol(push[2 * (N - 1)], -100.0, 1e-9);
+    /* too short: pushed apart, along the link */
+    for (size_t i = 0; i < N; ++i) {
+        rel[2 * i] = 0.0;
+        rel[2 * i + 1] = -(1000.0 - 10.0 * (double)i);
+    }
+    ck_assert_int_eq(sim_link_clamp_track(rel, N, 900.0, 1100.0, NULL, push), 20);
+    ck_assert_double_eq_tol(push[2 * (N - 1) + 1], -100.0, 1e-9);
+    ck_assert_double_eq_tol(push[2 * (N - 1)], 0.0, 1e-12);
+    /* bad calls */
+    ck_assert_int_eq(sim_link_clamp_track(NULL, N, 900.0, 1100.0, NULL, push), -1);
+    ck_assert_int_eq(sim_link_clamp_track(rel, N, 900.0, 1100.0, NULL, NULL), -1);
+    ck_assert_int_eq(sim_link_clamp_track(rel, N, 1100.0, 900.0, NULL, push), -1);
+    ck_assert_int_eq(sim_link_clamp_track(rel, N, NAN, 1100.0, NULL, push), -1);
+    ck_assert_int_eq(sim_link_clamp_track(rel, 0U, 900.0, 1100.0, NULL, push), 0);
+    /* A and B on one spot: pushed apart along the fallback direction the caller gives */
+    double px, py;
+    ck_assert(sim_link_push(0.0, 0.0, 900.0, 1100.0, 0.0, 1.0, &px, &py));
+    ck_assert_double_eq(px, 0.0);
+    ck_assert_double_eq_tol(py, 450.0, 1e-12);
+    ck_assert(!sim_link_push(0.0, 1000.0, 900.0, 1100.0, 1.0, 0.0, &px, &py));
+    ck_assert_double_eq(px, 0.0);
+}
+END_TEST
+
+/* The floor that follows a wheel by at most lim per step: a step from 0 to 10 with lim 3 is
+ * reached in four steps (3, 6, 9, 10), a drop to 0 the same way down; NULL arrays are refused. */
+START_TEST(rate_limiter_follows_its_input_by_at_most_the_limit)
+{
+    const double v[8] = {10.0, 10.0, 10.0, 10.0, 10.0, 0.0, 0.0, 0.0};
+    const double lim[8] = {3.0, 3.0, 3.0, 3.0, 3.0, 4.0, 4.0, 4.0};
+    const double want[8] = {3.0, 6.0, 9.0, 10.0, 10.0, 6.0, 2.0, 0.0};
+    double out[8];
+    ck_assert_int_eq(sim_rate_limit(v, lim, 8U, out), 0);
+    for (size_t i = 0; i < 8U; ++i) {
+        ck_assert_double_eq(out[i], want[i]);
+    }
+    ck_assert_int_eq(sim_rate_limit(NULL, lim, 8U, out), -1);
+    ck_assert_int_eq(sim_rate_limit(v, NULL, 8U, out), -1);
+    ck_assert_int_eq(sim_rate_limit(v, lim, 8U, NULL), -1);
+    ck_assert_int_eq(sim_rate_limit(v, lim, 0U, out), 0);
+
+    /* the plane form: a wanted velocity (3, 4) (length 5) reached by steps of 2 along it, then a
+     * quarter turn to (-4, 3) limited to 2 along the difference (-7, -1), length sqrt(50) */
+    const double vx[4] = {3.0, 3.0, 3.0, -4.0}, vy[4] = {4.0, 4.0, 4.0, 3.0}, l2[4] = {2.0, 2.0, 2.0, 2.0};
+    double ox[4], oy[4];
+    ck_assert_int_eq(sim_rate_limit_2d(vx, vy, l2, 4U, ox, oy), 0);
+    ck_assert_double_eq_tol(ox[0], 1.2, 1e-12);
+    ck_assert_double_eq_tol(oy[0], 1.6, 1e-12);
+    ck_assert_double_eq_tol(ox[1], 2.4, 1e-12);
+    ck_assert_double_eq(ox[2], 3.0);
+    ck_assert_double_eq(oy[2], 4.0);
+    ck_assert_double_eq_tol(ox[3], 3.0 - 14.0 / sqrt(50.0), 1e-12);
+    ck_assert_double_eq_tol(oy[3], 4.0 - 2.0 / sqrt(50.0), 1e-12);
+    ck_assert_int_eq(sim_rate_limit_2d(vx, NULL, l2, 4U, ox, oy), -1);
+    ck_assert_int_eq(sim_rate_limit_2d(vx, vy, l2, 4U, ox, NULL), -1);
+}
+END_TEST
+
 START_TEST(world_refuses_bad_steps_and_bumps)
 {
     const sim_robot_t r = labmate();
@@ -700,6 +784,8 @@ static Suite *suite(void)
     tcase_add_test(tc, same_seed_gives_bit_identical_worlds_and_another_seed_differs);
     tcase_add_test(tc, set_trailer_follows_the_robot_and_its_encoders_count_its_travel);
     tcase_add_test(tc, clapper_linkage_geometry_follows_002_eq_10_11_16_and_clamps_at_its_range);
+    tcase_add_test(tc, clapper_stop_replayed_over_a_track_pushes_half_way_and_obeys_its_gate);
+    tcase_add_test(tc, rate_limiter_follows_its_input_by_at_most_the_limit);
     tcase_add_test(tc, world_refuses_bad_steps_and_bumps);
     tcase_add_test(tc, tire_compression_with_an_offset_load_acts_like_an_ed);
     tcase_add_test(tc, every_catalog_effect_has_an_example_scenario_that_enables_only_it);

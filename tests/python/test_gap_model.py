@@ -137,6 +137,39 @@ def test_clapper_link_clamp_pushes_both_trucks_half_way() -> None:
     assert dead_reckon(pr, {}, 0)[-1, 0] == pytest.approx(300.0)
 
 
+def test_clapper_stop_in_libodosim_equals_a_tick_by_tick_replay_of_world_c() -> None:
+    """model._clamp_push asks libodosim for world.c's stop over the whole track; a plain replay of
+    the rule (each tick: move both trucks, then halve the excess along the link where the gate
+    allows) gives the same pushes on random walks, gated or not, through both ends of the range."""
+    from odo_tools.gap.model import _clamp_push
+
+    def replay(pa, pb, lo, hi, gate):
+        push, o = np.zeros((len(pa), 2)), np.zeros(2)
+        for i in range(1, len(pa)):
+            r = pa[i, :2] - pb[i, :2] + 2.0 * o
+            ln = float(np.hypot(*r))
+            if (ln < lo or ln > hi) and (gate is None or gate[i]):
+                o += 0.5 * ((lo if ln < lo else hi) - ln) * r / ln
+            push[i] = o
+        return push
+
+    rng = np.random.default_rng(5)
+    ends = set()
+    for k in range(12):
+        n = int(rng.integers(50, 800))
+        pa = np.cumsum(rng.normal(0.0, 3.0, (n, 3)), axis=0)
+        pb = np.cumsum(rng.normal(0.0, 3.0, (n, 3)), axis=0) - [1000.0, 0.0, 0.0]
+        gate = rng.random(n + 2) < 0.7 if k % 2 else None
+        want = replay(pa, pb, 985.0, 1015.0, gate)
+        got = _clamp_push(pa, pb, 985.0, 1015.0, gate)
+        assert got is not None and np.allclose(got, want, atol=1e-9, rtol=0.0), k
+        ln = np.hypot(*(pa[:, :2] - pb[:, :2]).T)
+        ends |= {"lo" if ln.min() < 985.0 else "", "hi" if ln.max() > 1015.0 else ""}
+    assert {"lo", "hi"} <= ends
+    with pytest.raises(ValueError):
+        _clamp_push(pa, pb, 1015.0, 985.0, None)
+
+
 def test_drive_effects_do_not_act_on_a_passive_trailer() -> None:
     """world.c: slip and skid live in step_driven; a set's trailer rolls passively."""
     from odo_tools.gap.model import floor_travel

@@ -153,6 +153,22 @@ char *odosim_robot_limits_json(void);
 int odosim_firmware_track(const char *robot_path, const uint32_t *raw, size_t n, double *pose, char *err,
                           size_t errlen);
 
+/// The clapper's linkage stop (host_sim/src/world.c sim_link_clamp_track) replayed over a recorded
+/// motion, for the diagnosis's model: rel[2 i], rel[2 i + 1] is truck A - truck B (mm) at tick i
+/// as the wheels alone move them, gate[i] (NULL: always) whether the stop may act at tick i;
+/// push[2 i], push[2 i + 1] receives A's cumulative move (B's is its negative). Returns the
+/// number of ticks the stop acted, or -1 on NULL arrays or a range that is not finite and ordered.
+long odosim_link_clamp(const double *rel, size_t n, double lo_mm, double hi_mm, const unsigned char *gate,
+                       double *push);
+
+/// The rate limiter of the diagnosis's traction-slip laws (host_sim/src/ratelimit.h):
+/// out[i] = out[i-1] + clamp(v[i] - out[i-1], -lim[i], lim[i]) from 0. 0, or -1 on a NULL array.
+int odosim_rate_limit(const double *v, const double *lim, size_t n, double *out);
+
+/// Its plane form (a friction circle, sim_rate_limit_2d): the vector (ox, oy) follows (vx, vy)
+/// by at most lim[i] per step, from (0, 0). 0, or -1 on a NULL array.
+int odosim_rate_limit_2d(const double *vx, const double *vy, const double *lim, size_t n, double *ox, double *oy);
+
 #ifdef __cplusplus
 }
 #endif

@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.signal import lfilter
 
+from . import simlib
 from .io import Robot, RunData
 
 TIRE_LOAD_KG = 100.0  # tire_compression: k * load is what kinematics sees; load fixed at default
@@ -306,7 +307,7 @@ def slip_traction(pr: Prepared, ds: np.ndarray, a_max: float, b: float) -> np.nd
     lim = _grip(a_max, v[:, 0], v[:, 1], b) * pr.dt  # mm/s per tick
     u = np.empty_like(v)
     for w in (0, 1):
-        u[:, w] = _rate_limit(v[:, w], lim)
+        u[:, w] = simlib.rate_limit(v[:, w], lim)
     return u * pr.dt[:, None]
 
 
@@ -363,47 +364,10 @@ def slip_motor(pr: Prepared, ds: np.ndarray, a_max: float, tau: float, b: float)
     out = ds.copy()
     for w in (0, 1):
         wheel = prof[w].ravel()
-        floor = _rate_limit(wheel, lim)
+        floor = simlib.rate_limit(wheel, lim)
         ahead = wheel - floor
         lost = 0.5 * (ahead + np.concatenate([[0.0], ahead[:-1]])) * h
         out[:, w] -= lost.reshape(-1, S).sum(axis=1)
-    return out
-
-
-def _rate_limit(v: np.ndarray, lim: np.ndarray) -> np.ndarray:
-    """u_i = u_(i-1) + clip(v_i - u_(i-1), -lim_i, lim_i) from u = 0, as a per-tick loop would
-    compute it, bit for bit. Sequential only where the limit bites: while the output equals the
-    input (u_(i-1) == v_(i-1)) and the next step is within the limit and lands exactly on v_i,
-    a stretch is copied; elsewhere one tick at a time over Python floats, from the first tick
-    that is not a plain copy (before it the output is the input)."""
-    n = v.size
-    prev = np.concatenate([[0.0], v[:-1]])
-    d = v - prev
-    fast = ~(d > lim) & ~(d < -lim) & (prev + d == v)  # what a step from u = v_(i-1) gives
-    slow = np.flatnonzero(~fast)
-    out = v.copy()
-    if slow.size == 0:
-        return out
-    i0 = int(slow[0])
-    stop = [*(slow - i0).tolist(), n - i0]  # ticks the loop must take one by one
-    vl, ll = v[i0:].tolist(), lim[i0:].tolist()
-    m = n - i0
-    p0 = cur = float(prev[i0])  # the output so far is the input
-    i, k = 0, 0
-    while i < m:
-        if cur == (vl[i - 1] if i else p0):  # tracking: jump to the next slow tick
-            while stop[k] < i:
-                k += 1
-            j = stop[k]
-            if j > i:
-                cur, i = vl[j - 1], j
-                if i == m:
-                    break
-                continue
-        dd, li = vl[i] - cur, ll[i]
-        cur = cur + (li if dd > li else (-li if dd < -li else dd))
-        out[i0 + i] = cur
-        i += 1
     return out
 
 
@@ -762,38 +726,8 @@ def _clamp_push(pa: np.ndarray, pb: np.ndarray, lo: float, hi: float, gate) -> n
     bad = np.flatnonzero(out_of)
     if bad.size == 0:
         return None
-    n = pa.shape[0]
-    i0 = max(int(bad[0]), 1)
-    # sequential (each push moves the next tick's link): a loop over Python floats
-    da, db = np.diff(pa[:, :2], axis=0).tolist(), np.diff(pb[:, :2], axis=0).tolist()
-    gl = gate.tolist() if gate is not None else None
-    xa, ya = float(pa[i0 - 1, 0]), float(pa[i0 - 1, 1])
-    xb, yb = float(pb[i0 - 1, 0]), float(pb[i0 - 1, 1])
-    push = np.zeros((n, 2))
-    rows = []
-    ox = oy = 0.0
-    for i in range(i0, n):
-        dax, day = da[i - 1]
-        dbx, dby = db[i - 1]
-        xa += dax
-        ya += day
-        xb += dbx
-        yb += dby
-        dx, dy = xa - xb, ya - yb
-        li = math.hypot(dx, dy)
-        if (li < lo or li > hi) and (gl is None or gl[i]):
-            half = 0.5 * ((lo if li < lo else hi) - li)
-            ux, uy = (dx / li, dy / li) if li > 0 else (1.0, 0.0)
-            xa += half * ux
-            ya += half * uy
-            xb -= half * ux
-            yb -= half * uy
-            ox += half * ux
-            oy += half * uy
-        rows.append((ox, oy))
-    if rows:
-        push[i0:] = rows
-    return push
+    # sequential (each push moves the next tick's link): world.c's own stop, replayed in C
+    return simlib.link_clamp(pa[:, :2] - pb[:, :2], lo, hi, gate)
 
 
 def link_bias(P: dict, alpha: np.ndarray, beta: np.ndarray) -> tuple:

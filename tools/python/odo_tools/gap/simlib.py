@@ -14,6 +14,8 @@ import os
 from functools import lru_cache
 from pathlib import Path
 
+import numpy as np
+
 from .errors import GapInputError
 from .repo import source_dir
 
@@ -123,6 +125,11 @@ def lib() -> C.CDLL:
     so.odosim_free.argtypes = [C.c_void_p]
     so.odosim_sizeof.restype = C.c_size_t
     so.odosim_sizeof.argtypes = [C.c_char_p]
+    dbl = C.POINTER(C.c_double)
+    so.odosim_link_clamp.restype = C.c_long
+    so.odosim_link_clamp.argtypes = [dbl, C.c_size_t, C.c_double, C.c_double, C.POINTER(C.c_ubyte), dbl]
+    so.odosim_rate_limit.argtypes = [dbl, dbl, C.c_size_t, dbl]
+    so.odosim_rate_limit_2d.argtypes = [dbl, dbl, dbl, C.c_size_t, dbl, dbl]
     bad = check_layouts(so)
     if bad:
         raise GapInputError(lib_path(), "ctypes layouts do not match libodosim: " + "; ".join(bad))
@@ -146,6 +153,64 @@ def check_layouts(so: C.CDLL) -> list[str]:
         if n != C.sizeof(cls):
             bad.append(f"{name}: C {n} bytes, ctypes {C.sizeof(cls)}")
     return bad
+
+
+def link_clamp(rel: np.ndarray, lo: float, hi: float, gate: np.ndarray | None) -> np.ndarray:
+    """(n, 2) cumulative move of truck A by the clapper's stop (world.c sim_link_clamp_track) over
+    rel, the (n, 2) link vector A - B as the wheels alone move it; gate (n,) bool or None."""
+    rel = np.ascontiguousarray(rel, dtype=np.float64)
+    push = np.empty_like(rel)
+    g = None
+    if gate is not None:
+        g = np.ascontiguousarray(gate[: rel.shape[0]], dtype=np.uint8)
+        if g.size < rel.shape[0]:
+            raise ValueError("link_clamp: the gate is shorter than the track")
+    dbl = C.POINTER(C.c_double)
+    n = lib().odosim_link_clamp(
+        rel.ctypes.data_as(dbl),
+        rel.shape[0],
+        float(lo),
+        float(hi),
+        None if g is None else g.ctypes.data_as(C.POINTER(C.c_ubyte)),
+        push.ctypes.data_as(dbl),
+    )
+    if n < 0:
+        raise ValueError(f"link_clamp: bad range [{lo}, {hi}]")
+    return push
+
+
+def rate_limit(v: np.ndarray, lim: np.ndarray) -> np.ndarray:
+    """u_i = u_(i-1) + clip(v_i - u_(i-1), -lim_i, lim_i) from u = 0 (host_sim/src/ratelimit.c),
+    for 1-D v and lim of one length."""
+    v = np.ascontiguousarray(v, dtype=np.float64)
+    lim = np.ascontiguousarray(lim, dtype=np.float64)
+    if v.ndim != 1 or lim.shape != v.shape:
+        raise ValueError(f"rate_limit: shapes {v.shape} and {lim.shape}")
+    out = np.empty_like(v)
+    dbl = C.POINTER(C.c_double)
+    lib().odosim_rate_limit(v.ctypes.data_as(dbl), lim.ctypes.data_as(dbl), v.size, out.ctypes.data_as(dbl))
+    return out
+
+
+def rate_limit_2d(v: np.ndarray, lim: np.ndarray) -> np.ndarray:
+    """The plane form (host_sim/src/ratelimit.c sim_rate_limit_2d, a friction circle): (n, 2)
+    vectors following v (n, 2) by at most lim_i (n,) per step, from (0, 0)."""
+    v = np.asarray(v, dtype=np.float64)
+    lim = np.ascontiguousarray(lim, dtype=np.float64)
+    if v.ndim != 2 or v.shape[1] != 2 or lim.shape != (v.shape[0],):
+        raise ValueError(f"rate_limit_2d: shapes {v.shape} and {lim.shape}")
+    vx, vy = np.ascontiguousarray(v[:, 0]), np.ascontiguousarray(v[:, 1])
+    ox, oy = np.empty_like(vx), np.empty_like(vy)
+    dbl = C.POINTER(C.c_double)
+    lib().odosim_rate_limit_2d(
+        vx.ctypes.data_as(dbl),
+        vy.ctypes.data_as(dbl),
+        lim.ctypes.data_as(dbl),
+        vx.size,
+        ox.ctypes.data_as(dbl),
+        oy.ctypes.data_as(dbl),
+    )
+    return np.column_stack([ox, oy])
 
 
 @lru_cache(maxsize=1)
