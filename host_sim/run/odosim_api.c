@@ -280,8 +280,7 @@ size_t odosim_sizeof(const char *type_name)
 
 void odosim_free(void *p) { free(p); }
 
-long odosim_link_clamp(const double *rel, size_t n, double lo_mm, double hi_mm, const unsigned char *gate,
-                       double *push)
+long odosim_link_clamp(const double *rel, size_t n, double lo_mm, double hi_mm, const unsigned char *gate, double *push)
 {
     return sim_link_clamp_track(rel, n, lo_mm, hi_mm, gate, push);
 }

@@ -455,8 +455,7 @@ static void step_trailer(sim_world_t *w, const sim_pose_t *a0)
     }
 }
 
-bool sim_link_push(double dx, double dy, double lo_mm, double hi_mm, double ux0, double uy0, double *px,
-                   double *py)
+bool sim_link_push(double dx, double dy, double lo_mm, double hi_mm, double ux0, double uy0, double *px, double *py)
 {
     const double l = hypot(dx, dy);
     *px = 0.0;
@@ -497,8 +496,8 @@ static void clamp_link(sim_world_t *w)
 {
     sim_pose_t *a = &w->truck[0].pose, *b = &w->truck[1].pose;
     double px, py;
-    w->clamped_last = sim_link_push(a->x_mm - b->x_mm, a->y_mm - b->y_mm, w->robot.link.min_mm,
-                                    w->robot.link.max_mm, cos(a->theta_rad), sin(a->theta_rad), &px, &py);
+    w->clamped_last = sim_link_push(a->x_mm - b->x_mm, a->y_mm - b->y_mm, w->robot.link.min_mm, w->robot.link.max_mm,
+                                    cos(a->theta_rad), sin(a->theta_rad), &px, &py);
     if (!w->clamped_last) {
         return;
     }

@@ -208,8 +208,7 @@ unsigned long sim_world_link_clamps(const sim_world_t *w);
 /// The clapper's stop: the move of truck A (B moves by its negative) that brings the link vector
 /// A - B = (dx, dy) back to the nearer end of [lo_mm, hi_mm], along the link, or along (ux0, uy0)
 /// where A and B coincide. False with a zero move when the length lies within the range.
-bool sim_link_push(double dx, double dy, double lo_mm, double hi_mm, double ux0, double uy0, double *px,
-                   double *py);
+bool sim_link_push(double dx, double dy, double lo_mm, double hi_mm, double ux0, double uy0, double *px, double *py);
 
 /// The same stop replayed over a whole recorded motion (the diagnosis's model, gap/model.py, asks
 /// for it once per fit step): rel[2 i], rel[2 i + 1] is A - B at tick i as the wheels alone would

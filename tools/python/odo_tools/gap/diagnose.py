@@ -280,7 +280,7 @@ def rank(ds: Dataset, sel: Selection, progress: Progress = None) -> Ranking:
         # shows only through its mean, which shortens every turn like an Eb (its alias; the
         # report lists it under "not identifiable")
         hyps = [h for h in hyps if "roughness" not in h.families]
-    for fam in proposals:
+    for fam in [*hypotheses.ALWAYS, *(f for f in proposals if f not in hypotheses.ALWAYS)]:
         hyps += hypotheses.other_laws(fam, ds.mode, ds.robot.vehicle)
     trucks = truck_excess(prob.items, {}, prob.sigma) if ds.robot.n_trucks == 2 else []
     scoped = None
@@ -618,10 +618,23 @@ ROUGH_MIN_MM = 0.05  # a roughness fitted below this is no floor at all
 def _real(f: Fit) -> bool:
     """A roughness fitted to (next to) zero height is the nominal noise without the measured
     walk, not a floor: as a member it would win a pair for the walk's parameter alone (the
-    blind check's slip came out roughness+slip at 0.0 mm)."""
-    return "roughness" not in f.hyp.families or (
-        f.params.get("roughness.max_height_mm", 0.0) >= ROUGH_MIN_MM
-    )
+    blind check's slip came out roughness+slip at 0.0 mm). A law's own shape parameter at
+    either end of its range (SHAPE_KEYS) is the catalog's law (at zero) or another effect
+    bent into it (at the top): the OptiOdom robot's returns took Eb's load law at zeta 2.0, a
+    wheelbase doubling under half a g, for its turn-radius-dependent wheelbase."""
+    if "roughness" in f.hyp.families and (
+        f.params.get("roughness.max_height_mm", 0.0) < ROUGH_MIN_MM
+    ):
+        return False
+    for k, v in f.params.items():
+        if k.removesuffix(".A").removesuffix(".B") in SHAPE_KEYS:
+            lo, hi, _ = hypotheses.bounds(k)
+            if v <= lo + 1e-6 * (hi - lo) or v >= hi - 1e-3 * (hi - lo):
+                return False
+    return True
+
+
+SHAPE_KEYS = ("eb@load.zeta",)
 
 
 def _warm(fits: list[Fit], names: set[str]) -> dict:

@@ -270,9 +270,11 @@ def fit_params(
     base: dict | None = None,
     warm: dict | None = None,
     bnd: dict | None = None,
+    starts: list[dict] | None = None,
 ) -> tuple[dict, dict]:
     """Bounded least squares of `keys` (others from `base`). `warm`: start values (pairs start
-    from their singles' fits, one start; else the catalog start and, for slip/skid, a second)."""
+    from their singles' fits, one start; else the catalog start and, for slip/skid, a second).
+    `starts`: further starts, each overriding some keys' start values (unless warm)."""
     base = dict(base or {})
     if not keys:
         return base, {}
@@ -288,15 +290,17 @@ def fit_params(
         return prob.wresid(P)
 
     best = None
-    starts = [x0]
+    todo = [x0]
     if not warm and any(k.startswith(("slip.", "skid.")) for k in keys):
-        starts.append(
+        todo.append(
             [
                 min(h, 0.5) if k.startswith(("slip.", "skid.")) else s
                 for k, s, h in zip(keys, x0, hi, strict=True)
             ]
         )
-    for s0 in starts:
+    if not warm:
+        todo += [[o.get(k, s) for k, s in zip(keys, x0, strict=True)] for o in starts or ()]
+    for s0 in todo:
         s0 = np.clip(s0, np.array(lo) + 1e-12, np.array(hi) - 1e-12)
         res = least_squares(
             f, s0, bounds=(lo, hi), x_scale="jac", max_nfev=60, ftol=1e-6, xtol=1e-6, gtol=1e-6
@@ -351,8 +355,17 @@ def fit_hypothesis(
 
         for t in range(len(prs[0].b)):
             fixed[f"count_loss@plateau.level_mm_s.{'AB'[t]}"] = plateau_level(prs, t)
+    starts = []
+    fric = [k for k in keys if k.startswith("skid@friction.a_lim_m_s2")]
+    if fric and warm is None:
+        # a friction limit above every demand the runs make changes nothing (no gradient): start
+        # it below the hardest demand the counts show, at three depths
+        from .model import accel_demand
+
+        peak = accel_demand(prs)
+        starts += [{k: f * peak for k in fric} for f in (0.8, 0.5, 0.25)]
     if not hyp.has_bumps:
-        P, se = fit_params(prob, keys, fixed, warm=warm, bnd=bnd)
+        P, se = fit_params(prob, keys, fixed, warm=warm, bnd=bnd, starts=starts)
         return evaluate(prob, hyp.name, P, se, len(keys), hyp=hyp)
     if floor_bumps is not None:
         fb = floor_bumps
@@ -362,7 +375,11 @@ def fit_hypothesis(
             P0 = dict(base_params) if base_params is not None else fit_params(prob, keys)[0]
         fb = cluster_bumps(detect_bumps(prob.items, P0, sig_head))
     place_bumps(prs, fb, own=True)
-    P, se = fit_params(prob, keys, dict(fixed), warm=warm, bnd=bnd) if keys else (dict(fixed), {})
+    P, se = (
+        fit_params(prob, keys, dict(fixed), warm=warm, bnd=bnd, starts=starts)
+        if keys
+        else (dict(fixed), {})
+    )
     h = float(np.median([b["h"] for b in fb])) if fb else 0.0
     P = dict(P)
     P["bumps.height_mm"] = h

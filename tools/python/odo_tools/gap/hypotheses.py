@@ -42,6 +42,8 @@ EXTRA_BOUNDS = {
     "count_loss@plateau.excess_mm_s": (0.0, 5000.0, 400.0),
     "count_loss@plateau.a_m_s2": (0.05, 20.0, 1.0),
     "skid@cornering.deg_per_m_s2": (0.0, 30.0, 1.0),
+    "skid@friction.a_lim_m_s2": (0.05, 20.0, 2.0),
+    "eb@load.zeta": (0.0, 1.0, 0.05),
 }
 START = {"slip.k_per_m_s2": 0.05, "skid.k_s": 0.05, "roughness.max_height_mm": 0.5}
 
@@ -77,6 +79,15 @@ def catalog_law(effect: str, vehicle: str) -> Law:
 
 # the other laws of a family (model.py implements each)
 OTHER_LAWS = {
+    "eb": (
+        Law(
+            "eb",
+            "load",
+            ("eb.value", "eb@load.zeta"),
+            "a wheelbase that grows with the lateral load: Eb (1 + zeta |a_lat| / g), so a "
+            "circle driven faster turns less",
+        ),
+    ),
     "slip": (
         Law(
             "slip",
@@ -107,6 +118,13 @@ OTHER_LAWS = {
             ("skid@cornering.deg_per_m_s2",),
             "linear cornering stiffness: a slip angle proportional to the centripetal "
             "acceleration, from the gentlest arc up (no threshold)",
+        ),
+        Law(
+            "skid",
+            "friction",
+            ("skid@friction.a_lim_m_s2",),
+            "friction circle: the truck's centre changes its velocity by at most a_lim in any "
+            "direction; beyond it the centre falls behind the wheels' path, the heading follows",
         ),
     ),
     "count_loss": (
@@ -217,6 +235,9 @@ PROPOSE = {
     "count_loss": ("fast",),
     "skid": ("arc",),
 }
+# families whose other laws are always tried: a load-dependent Eb shows in no one phase (every
+# arc, more so the faster), and one cheap fit beside the catalog's Eb costs less than missing it
+ALWAYS = ("eb",)
 PROPOSE_SHARE = 0.25  # a phase holding this share of the excess misfit proposes its families
 PROPOSE_DENSITY = 2.0  # ... or this many times its share of the run
 

@@ -224,6 +224,9 @@ def floor_travel(
     bt = b * P.get("eb.value", 1.0)
     lat = np.zeros(ds.shape[0])
     g = scrub_factor(ds, P.get("scrub.k", 0.0)) if drive else None
+    z = P.get("eb@load.zeta", 0.0)
+    if z > 0:
+        g = eb_load(pr, ds, bt, g, z)
     ks = P.get("skid.k_s", 0.0) if drive else 0.0
     if ks > 0:
         ac = centripetal(pr, ds, bt, g)
@@ -253,6 +256,20 @@ def skid_cornering(
     that law gives nothing (independent world, seed 2721 case 28)."""
     beta = np.radians(kc) * centripetal(pr, ds, bt, g)
     return -0.5 * (ds[:, 0] + ds[:, 1]) * np.tan(np.clip(beta, -0.5, 0.5))
+
+
+def eb_load(pr: Prepared, ds: np.ndarray, bt: float, g: np.ndarray | None, z: float) -> np.ndarray:
+    """A wheelbase that grows with the lateral load: b (1 + z |a_lat| / g0), the tyres' contact
+    patches shifting outward as the load moves to the outer wheel, so each tick's heading
+    change is divided by 1 + z |a_lat| / g0 (a_lat the tick's centripetal acceleration from the
+    floor travel). Unlike scrub it follows speed squared over radius: a circle driven faster
+    turns less."""
+    ac = np.abs(centripetal(pr, ds, bt, g))
+    f = 1.0 / (1.0 + z * ac / G0)
+    return f if g is None else g * f
+
+
+G0 = 9.80665  # m/s^2
 
 
 def scrub_factor(ds: np.ndarray, k: float) -> np.ndarray | None:
@@ -583,6 +600,48 @@ def integrate(
     return out
 
 
+def floor_track(pr: Prepared, P: dict, truck: int, pose0=(0.0, 0.0, 0.0)) -> np.ndarray:
+    """(n, 3) one truck's track under P: the floor travel dead-reckoned, then the friction-circle
+    skid on a driven truck's centre (skid_friction; it needs the track's world-frame motion)."""
+    p = integrate(*floor_travel(pr, P, truck), pose0=pose0)
+    a = truck_view(P, truck).get("skid@friction.a_lim_m_s2", 0.0) if pr.driven[truck] else 0.0
+    return skid_friction(pr, p, a) if a > 0 else p
+
+
+def skid_friction(pr: Prepared, p: np.ndarray, a_lim: float) -> np.ndarray:
+    """The friction circle on the truck's centre: the wheels ask it to move, tick by tick, as
+    the track p (n, 3) does; the floor changes its velocity by at most a_lim (m/s^2) in any
+    direction, along and across the heading together, so in a turn whose centripetal
+    acceleration (or a start whose acceleration) asks for more the centre falls behind the
+    wheels' path (on a circle it settles at a_lim r / v); the heading follows the wheels. A
+    skid above a threshold (the catalog's, and skid_cornering's slip angle) grows with the
+    excess; this one is all or nothing per tick, which a floor that gives way at a grip limit
+    shows (the independent world's laws.friction_circle is one such)."""
+    dt = pr.dt
+    v = np.diff(p[:, :2], axis=0) / dt[:, None]
+    u = simlib.rate_limit_2d(v, a_lim * 1e3 * dt)
+    out = p.copy()
+    np.cumsum(u[:, 0] * dt, out=out[1:, 0])
+    np.cumsum(u[:, 1] * dt, out=out[1:, 1])
+    out[1:, :2] += p[0, :2]
+    return out
+
+
+def accel_demand(prs: list, q: float = 99.0) -> float:
+    """The q-th percentile (m/s^2) of the acceleration the counts ask of a driven truck's centre,
+    along and across the heading together (|dv|/dt of the nominal track, tick by tick), over
+    the runs prs: where a friction limit starts to bite."""
+    a = []
+    for pr in prs:
+        for t, drive in enumerate(pr.driven):
+            if drive:
+                p = integrate(*floor_travel(pr, {}, t))
+                v = np.diff(p[:, :2], axis=0) / pr.dt[:, None]
+                dv = np.diff(np.vstack([[0.0, 0.0], v]), axis=0)
+                a.append(np.hypot(dv[:, 0], dv[:, 1]) / pr.dt * 1e-3)
+    return float(np.percentile(np.concatenate(a), q)) if a else 1.0
+
+
 # effects on the linkage encoders' readings only: the trucks' tracks do not depend on them, so a
 # fit of them reuses the cached tracks instead of dead-reckoning again for every step
 SENSOR_ONLY = ("rotary_bias.", "link_bias.")
@@ -607,7 +666,7 @@ def _track(pr: Prepared, P: dict, truck: int) -> np.ndarray:
     if hit is None:
         if len(cache) >= TRACK_CACHE:  # least recently used out (a dict keeps insertion order)
             del cache[next(iter(cache))]
-        hit = integrate(*floor_travel(pr, P, truck))
+        hit = floor_track(pr, P, truck)
     cache[key] = hit  # (re)inserted last: most recently used
     return hit
 
@@ -656,7 +715,7 @@ def dead_reckon(pr: Prepared, P: dict, truck: int = 0, pose0=(0.0, 0.0, 0.0)) ->
     if tuple(pose0) == (0.0, 0.0, 0.0):
         p = _track(pr, P, truck)
     else:
-        p = integrate(*floor_travel(pr, P, truck), pose0=pose0)
+        p = floor_track(pr, P, truck, pose0)
     if pr.link is None or len(pr.R) < 2:
         return p.copy()
     return _clamp_link(pr, p, _track(pr, P, 1 - truck), truck, pose0)

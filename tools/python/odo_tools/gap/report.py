@@ -48,6 +48,10 @@ LAW_WORDS = {
     "rises beyond it and back",
     "cornering": "linear cornering stiffness: the tyres run at a slip angle proportional to the "
     "centripetal acceleration, from the gentlest arc up (no threshold)",
+    "load": "a wheelbase that grows with the lateral load (speed squared over radius): "
+    "Eb (1 + zeta |a_lat| / g)",
+    "friction": "friction circle: the truck's centre changes its velocity by at most a_lim; "
+    "beyond it (fast turns) the centre falls behind the wheels' path while the heading follows",
 }
 # effects a parameter block corrects (odo-calib): what a next step can fix on the robot
 KINEMATIC = ("ed", "eb", "es", "scrub")
@@ -78,6 +82,8 @@ def unit(key: str) -> str:
             "deg_per_m_s2": "deg/(m/s^2)",
             "excess_mm_s": "mm/s",
             "a_m_s2": "m/s^2",
+            "a_lim_m_s2": "m/s^2",
+            "zeta": "1",
         }.get(p, "")
     return "" if u in ("1", "-") else u
 

@@ -127,7 +127,14 @@ def lib() -> C.CDLL:
     so.odosim_sizeof.argtypes = [C.c_char_p]
     dbl = C.POINTER(C.c_double)
     so.odosim_link_clamp.restype = C.c_long
-    so.odosim_link_clamp.argtypes = [dbl, C.c_size_t, C.c_double, C.c_double, C.POINTER(C.c_ubyte), dbl]
+    so.odosim_link_clamp.argtypes = [
+        dbl,
+        C.c_size_t,
+        C.c_double,
+        C.c_double,
+        C.POINTER(C.c_ubyte),
+        dbl,
+    ]
     so.odosim_rate_limit.argtypes = [dbl, dbl, C.c_size_t, dbl]
     so.odosim_rate_limit_2d.argtypes = [dbl, dbl, dbl, C.c_size_t, dbl, dbl]
     bad = check_layouts(so)
@@ -188,7 +195,9 @@ def rate_limit(v: np.ndarray, lim: np.ndarray) -> np.ndarray:
         raise ValueError(f"rate_limit: shapes {v.shape} and {lim.shape}")
     out = np.empty_like(v)
     dbl = C.POINTER(C.c_double)
-    lib().odosim_rate_limit(v.ctypes.data_as(dbl), lim.ctypes.data_as(dbl), v.size, out.ctypes.data_as(dbl))
+    lib().odosim_rate_limit(
+        v.ctypes.data_as(dbl), lim.ctypes.data_as(dbl), v.size, out.ctypes.data_as(dbl)
+    )
     return out
 
 

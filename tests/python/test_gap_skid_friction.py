@@ -1,0 +1,137 @@
+"""Two laws of the independent world's physics the catalog's do not follow (issue 13 item 3):
+a friction-circle skid (the floor changes the truck's centre velocity by at most a_lim in any
+direction; the catalog's skid grows with the excess over a threshold) and a wheelbase that grows
+with the lateral load (Eb (1 + zeta |a_lat| / g); the catalog's Eb is one number). Each was
+"unexplained", or named with a scrub beside it, on development seeds 2741 and 2721."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+from gap_support import BUILD, SRC, indep_case
+
+
+@pytest.fixture(autouse=True)
+def _env(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("ODO_BUILD_DIR", str(BUILD))
+    monkeypatch.setenv("ODO_SOURCE_DIR", str(SRC))
+
+
+def _circle(v_mm_s: float, r_mm: float, T: float = 0.04, n: int = 400) -> tuple:
+    """A truck's track accelerating from rest at 0.5 m/s^2 to v on a circle of radius r: (pr, p)."""
+    speed = np.minimum(500.0 * T * np.arange(1, n + 1), v_mm_s)
+    s = np.concatenate([[0.0], np.cumsum(speed * T)])
+    th = s / r_mm
+    p = np.column_stack([r_mm * np.sin(th), r_mm * (1.0 - np.cos(th)), th])
+    return SimpleNamespace(dt=np.full(n, T)), p
+
+
+def test_friction_skid_leaves_a_track_the_floor_can_follow_alone() -> None:
+    """Below the limit (0.5 m/s^2 to start, 0.8 m/s^2 around a 0.5 m circle at 632 mm/s) the
+    track comes back as it went in; above it the centre falls behind, its velocity never
+    changing faster than the limit, while the heading follows the wheels."""
+    from odo_tools.gap.model import skid_friction
+
+    pr, p = _circle(632.0, 500.0)
+    assert np.allclose(skid_friction(pr, p, 1.0), p, atol=1e-9, rtol=0.0)
+    out = skid_friction(pr, p, 0.6)
+    assert np.array_equal(out[:, 2], p[:, 2])  # the heading follows the wheels
+    v = np.diff(out[:, :2], axis=0) / pr.dt[:, None]
+    a = np.hypot(*np.diff(np.vstack([[0.0, 0.0], v]), axis=0).T) / pr.dt
+    assert a.max() <= 600.0 * (1 + 1e-9)
+    # on the circle it settles where the floor's whole grip turns its velocity with the
+    # heading: |u| omega = a_lim, so it runs at a_lim r / v, behind the wheels' 632 mm/s
+    speed = np.hypot(*v[-1])
+    assert speed == pytest.approx(600.0 * 500.0 / 632.0, rel=0.01)
+    assert a[-1] == pytest.approx(600.0, rel=1e-6)
+
+
+def test_friction_limiter_in_libodosim_is_the_plain_replay() -> None:
+    """simlib.rate_limit_2d (host_sim/src/ratelimit.c) against the rule written out per step."""
+    from odo_tools.gap.simlib import rate_limit_2d
+
+    rng = np.random.default_rng(4)
+    v = np.cumsum(rng.normal(0.0, 40.0, (500, 2)), axis=0)
+    lim = rng.uniform(5.0, 60.0, 500)
+    want, cur = np.empty_like(v), np.zeros(2)
+    for i in range(v.shape[0]):
+        d = v[i] - cur
+        m = float(np.hypot(*d))
+        cur = cur + (d * (lim[i] / m) if m > lim[i] else d)
+        want[i] = cur
+    got = rate_limit_2d(v, lim)
+    assert np.allclose(got, want, atol=1e-9, rtol=0.0)
+    assert not np.allclose(got, v)  # the limit bit: the comparison can fail
+    with pytest.raises(ValueError):
+        rate_limit_2d(v, lim[:-1])
+
+
+def test_load_dependent_wheelbase_divides_each_ticks_turn() -> None:
+    """eb@load: a tick's heading change over 1 + zeta |a_lat| / g, a_lat = v omega from the
+    tick's own travel; a spot turn (v = 0) keeps the catalog Eb's turn."""
+    from odo_tools.gap.model import G0, eb_load
+
+    T, b = 0.05, 300.0
+    ds = np.array([[40.0, 50.0], [-10.0, 10.0], [30.0, 30.0]])  # an arc, a spot turn, a straight
+    g = eb_load(SimpleNamespace(dt=np.full(3, T)), ds, b, None, 0.2)
+    v, om = 45.0 / T * 1e-3, 10.0 / b / T
+    assert g[0] == pytest.approx(1.0 / (1.0 + 0.2 * v * om / G0), rel=1e-12)
+    assert g[1] == 1.0 and g[2] == 1.0
+
+
+def test_a_friction_circle_skid_is_named_with_its_limit(tmp_path: Path) -> None:
+    """Independent world, seed 2741 case 56: a LabMate (100 ms tick) whose floor gives
+    0.27 m/s^2; its arcs ask 1.5. The catalog's skid (and the cornering law) left the held-out
+    runs at 290 x the background, "unexplained"; the friction circle names the skid and its
+    limit."""
+    from odo_tools.gap.diagnose import diagnose
+
+    real = tmp_path / "real"
+    c = indep_case(2741, 56, real, "labmate", {"skid": "friction"})
+    rep = diagnose(real, real / "robot.json", mode="truth").to_dict()
+    v = rep["verdict"]
+    assert v["effect"] == "skid", v
+    assert v["laws"]["skid"]["law"] == "friction", v["laws"]
+    true = c["true"]["effects"]["skid"]["a_lim_m_s2"]
+    assert v["params"]["skid@friction.a_lim_m_s2"] == pytest.approx(true, rel=0.05)
+    assert rep["heldout"]["ratio_after"] < 0.1 * rep["heldout"]["ratio_before"]
+
+
+def test_a_wheelbase_under_lateral_load_is_named_eb_alone(tmp_path: Path) -> None:
+    """Independent world, seed 2721 case 10: a LabMate whose wheelbase is 0.987 on the spot and
+    grows 17 % of the lateral acceleration in g. The catalog's Eb needed a scrub beside it
+    ("eb+scrub"); the load law names the Eb alone, with both numbers."""
+    from odo_tools.gap.diagnose import diagnose
+
+    real = tmp_path / "real"
+    c = indep_case(2721, 10, real, "labmate", {"eb": "load_patch"})
+    rep = diagnose(real, real / "robot.json", mode="truth").to_dict()
+    v = rep["verdict"]
+    assert v["effect"] == "eb", v
+    assert v["laws"]["eb"]["law"] == "load", v["laws"]
+    e = c["true"]["effects"]["eb"]
+    assert v["params"]["eb.value"] == pytest.approx(e["value0"], abs=0.001)
+    assert v["params"]["eb@load.zeta"] == pytest.approx(e["zeta"], abs=0.06)
+
+
+def test_a_load_law_at_either_end_of_its_range_is_no_candidate() -> None:
+    """zeta at 0 is the catalog's Eb with a spare parameter; at the top of its range another
+    effect bent into the law (the OptiOdom robot's returns took zeta 2.0, a wheelbase doubling
+    under half a g, for its tyre scrub): neither ranks. Inside the range, on either truck, it
+    does."""
+    from odo_tools.gap import hypotheses
+    from odo_tools.gap.diagnose import _real
+
+    lo, hi, _ = hypotheses.bounds("eb@load.zeta")
+    law = next(x for x in hypotheses.OTHER_LAWS["eb"] if x.name == "load")
+
+    def fit(z: float, truck: str | None = None) -> SimpleNamespace:
+        h = hypotheses.Hypothesis((law if truck is None else law.on(truck),))
+        key = "eb@load.zeta" + ("" if truck is None else "." + truck)
+        return SimpleNamespace(hyp=h, params={key: z})
+
+    assert not _real(fit(lo)) and not _real(fit(hi)) and not _real(fit(hi, "B"))
+    assert _real(fit(0.17)) and _real(fit(0.17, "A"))
