@@ -12,7 +12,7 @@ from types import SimpleNamespace
 
 import numpy as np
 import pytest
-from gap_support import BUILD, SRC, indep_case
+from gap_support import BUILD, SRC, indep_named
 
 
 @pytest.fixture(autouse=True)
@@ -53,14 +53,8 @@ def test_cornering_skid_below_the_catalog_threshold_is_named(tmp_path: Path) -> 
     and judged on a cw circle at 0.22 m/s^2. The catalog's skid (threshold 0.3 m/s^2) fitted
     the former and predicted nothing on the latter: 11.9 x the background before and after,
     "unexplained". The cornering law names skid, its slope within a tenth of the world's."""
-    from odo_tools.gap.diagnose import diagnose
-
-    real = tmp_path / "real"
-    c = indep_case(2721, 28, real, "labmate", {"skid": "cornering"})
-    rep = diagnose(real, real / "robot.json", mode="truth").to_dict()
+    c, rep = indep_named(2721, 28, tmp_path, "labmate", {"skid": "cornering"}, "skid", "cornering")
     v = rep["verdict"]
-    assert v["effect"] == "skid", v
-    assert v["laws"]["skid"]["law"] == "cornering", v["laws"]
     true = math.degrees(1.0 / c["true"]["effects"]["skid"]["c_alpha_m_s2"])
     assert v["params"]["skid@cornering.deg_per_m_s2"] == pytest.approx(true, rel=0.1)
     assert rep["heldout"]["ratio_after"] < 1.5

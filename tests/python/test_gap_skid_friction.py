@@ -11,7 +11,7 @@ from types import SimpleNamespace
 
 import numpy as np
 import pytest
-from gap_support import BUILD, SRC, indep_case
+from gap_support import BUILD, SRC, indep_named
 
 
 @pytest.fixture(autouse=True)
@@ -87,14 +87,8 @@ def test_a_friction_circle_skid_is_named_with_its_limit(tmp_path: Path) -> None:
     0.27 m/s^2; its arcs ask 1.5. The catalog's skid (and the cornering law) left the held-out
     runs at 290 x the background, "unexplained"; the friction circle names the skid and its
     limit."""
-    from odo_tools.gap.diagnose import diagnose
-
-    real = tmp_path / "real"
-    c = indep_case(2741, 56, real, "labmate", {"skid": "friction"})
-    rep = diagnose(real, real / "robot.json", mode="truth").to_dict()
+    c, rep = indep_named(2741, 56, tmp_path, "labmate", {"skid": "friction"}, "skid", "friction")
     v = rep["verdict"]
-    assert v["effect"] == "skid", v
-    assert v["laws"]["skid"]["law"] == "friction", v["laws"]
     true = c["true"]["effects"]["skid"]["a_lim_m_s2"]
     assert v["params"]["skid@friction.a_lim_m_s2"] == pytest.approx(true, rel=0.05)
     assert rep["heldout"]["ratio_after"] < 0.1 * rep["heldout"]["ratio_before"]
@@ -104,14 +98,8 @@ def test_a_wheelbase_under_lateral_load_is_named_eb_alone(tmp_path: Path) -> Non
     """Independent world, seed 2721 case 10: a LabMate whose wheelbase is 0.987 on the spot and
     grows 17 % of the lateral acceleration in g. The catalog's Eb needed a scrub beside it
     ("eb+scrub"); the load law names the Eb alone, with both numbers."""
-    from odo_tools.gap.diagnose import diagnose
-
-    real = tmp_path / "real"
-    c = indep_case(2721, 10, real, "labmate", {"eb": "load_patch"})
-    rep = diagnose(real, real / "robot.json", mode="truth").to_dict()
+    c, rep = indep_named(2721, 10, tmp_path, "labmate", {"eb": "load_patch"}, "eb", "load")
     v = rep["verdict"]
-    assert v["effect"] == "eb", v
-    assert v["laws"]["eb"]["law"] == "load", v["laws"]
     e = c["true"]["effects"]["eb"]
     assert v["params"]["eb.value"] == pytest.approx(e["value0"], abs=0.001)
     assert v["params"]["eb@load.zeta"] == pytest.approx(e["zeta"], abs=0.06)
