@@ -123,3 +123,26 @@ def test_a_load_law_at_either_end_of_its_range_is_no_candidate() -> None:
 
     assert not _real(fit(lo)) and not _real(fit(hi)) and not _real(fit(hi, "B"))
     assert _real(fit(0.17)) and _real(fit(0.17, "A"))
+
+
+def test_a_pair_whose_load_law_went_to_zero_is_fitted_as_the_catalog_pair() -> None:
+    """A load law at zeta 0 beside a partner is that partner beside the catalog's Eb: the pair is
+    refitted as eb + ed (simulator seed 2742 case 33, where eb@load led the singles, eb + ed was
+    never formed and roughness won the returns), on either truck; inside its range it stays."""
+    from odo_tools.gap import hypotheses
+    from odo_tools.gap.diagnose import _as_catalog
+
+    load = next(x for x in hypotheses.OTHER_LAWS["eb"] if x.name == "load")
+    ed = hypotheses.catalog_law("ed", "labmate")
+
+    def fit(z: float, truck: str | None = None) -> SimpleNamespace:
+        law = load if truck is None else load.on(truck)
+        sfx = "" if truck is None else "." + truck
+        return SimpleNamespace(
+            hyp=hypotheses.Hypothesis((law, ed)),
+            params={"eb.value" + sfx: 0.974, "eb@load.zeta" + sfx: z, "ed.value": 1.004},
+        )
+
+    assert _as_catalog(fit(0.0), "labmate").name == "eb+ed"
+    assert _as_catalog(fit(0.0, "B"), "clapper").name == "eb[B]+ed"
+    assert _as_catalog(fit(0.09), "labmate") is None

@@ -326,7 +326,7 @@ def rank(ds: Dataset, sel: Selection, progress: Progress = None) -> Ranking:
     # pairs, unless the best single already leaves nothing but background on the fitting runs'
     # tracks (truth mode): most robots have one effect, and ten pair fits cost more than the rest
     if gap and not (ds.mode == "truth" and _track_ratio(best, prob, ds, sel) <= R_WITHIN):
-        cands += _pairs(singles, prob, fprs, sig_head, progress)
+        cands += _pairs(singles, prob, fprs, sig_head, progress, ds.robot.vehicle)
     cands.sort(key=lambda f: f.bic)
     c_hat = max(1.0, best.chi / max(prob.e0 - best.k, 1))
     pair = next((f for f in cands if f.hyp is not None and len(f.hyp.families) == 2), None)
@@ -629,7 +629,7 @@ def _real(f: Fit) -> bool:
     for k, v in f.params.items():
         if k.removesuffix(".A").removesuffix(".B") in SHAPE_KEYS:
             lo, hi, _ = hypotheses.bounds(k)
-            if v <= lo + 1e-6 * (hi - lo) or v >= hi - 1e-3 * (hi - lo):
+            if v <= _shape_lo(k) or v >= hi - 1e-3 * (hi - lo):
                 return False
     return True
 
@@ -645,7 +645,7 @@ def _warm(fits: list[Fit], names: set[str]) -> dict:
     return warm
 
 
-def _pairs(singles, prob, fprs, sig_head, progress) -> list[Fit]:
+def _pairs(singles, prob, fprs, sig_head, progress, vehicle: str) -> list[Fit]:
     """Pairs of the top singles (one law per family), and roughness with each of them."""
     top: list[Fit] = []
     for f in singles:
@@ -682,8 +682,38 @@ def _pairs(singles, prob, fprs, sig_head, progress) -> list[Fit]:
         if h.has_bumps:
             other = a if not a.hyp.has_bumps else b
             fb = bumps_for(other)
-        out.append(fit_hypothesis(h, prob, fprs, sig_head, fb, _warm(singles, {a.name, b.name})))
+        f = fit_hypothesis(h, prob, fprs, sig_head, fb, _warm(singles, {a.name, b.name}))
+        twin = None if _real(f) else _as_catalog(f, vehicle)
+        if twin is not None and twin.name not in {x.name for x in out} | {h.name}:
+            # the load law's zeta went to zero beside its partner: the pair is the catalog
+            # law's (simulator seed 2742 case 33: Eb's load law led the singles, so eb + ed was
+            # never formed, and eb@load + ed with zeta 0 is no candidate - roughness won)
+            warm = {k: v for k, v in f.model_params().items() if k in twin.params}
+            f = fit_hypothesis(twin, prob, fprs, sig_head, fb, warm)
+        out.append(f)
     return [f for f in out if _real(f)]
+
+
+def _as_catalog(f: Fit, vehicle: str) -> hypotheses.Hypothesis | None:
+    """f's hypothesis with each law whose shape parameters (SHAPE_KEYS) sit at the bottom of
+    their range replaced by its family's catalog law - the same model without them - or None
+    when there is none."""
+    laws, changed = [], False
+    for law in f.hyp.laws:
+        shape = [p for p in law.params if p.removesuffix(".A").removesuffix(".B") in SHAPE_KEYS]
+        low = [f.params.get(p, 0.0) <= _shape_lo(p) for p in shape]
+        if shape and all(low):
+            cat = hypotheses.catalog_law(law.family, vehicle)
+            laws.append(cat if law.truck is None else cat.on(law.truck))
+            changed = True
+        else:
+            laws.append(law)
+    return hypotheses.Hypothesis(tuple(laws)) if changed else None
+
+
+def _shape_lo(key: str) -> float:
+    lo, hi, _ = hypotheses.bounds(key)
+    return lo + 1e-6 * (hi - lo)
 
 
 def _third(pair: Fit, singles, prob, fprs, sig_head, progress) -> list[Fit]:
