@@ -626,15 +626,25 @@ def _real(f: Fit) -> bool:
         f.params.get("roughness.max_height_mm", 0.0) < ROUGH_MIN_MM
     ):
         return False
-    for k, v in f.params.items():
-        if k.removesuffix(".A").removesuffix(".B") in SHAPE_KEYS:
-            lo, hi, _ = hypotheses.bounds(k)
-            if v <= _shape_lo(k) or v >= hi - 1e-3 * (hi - lo):
-                return False
-    return True
+    return all(_shape_end(k, v) is None for k, v in f.params.items())
 
 
 SHAPE_KEYS = ("eb@load.zeta",)
+
+
+def _is_shape(key: str) -> bool:
+    return key.removesuffix(".A").removesuffix(".B") in SHAPE_KEYS
+
+
+def _shape_end(key: str, value: float) -> str | None:
+    """'low' or 'high' when `key` is a law's shape parameter (SHAPE_KEYS, on either truck) fitted
+    at that end of its range, else None."""
+    if not _is_shape(key):
+        return None
+    lo, hi, _ = hypotheses.bounds(key)
+    if value <= lo + 1e-6 * (hi - lo):
+        return "low"
+    return "high" if value >= hi - 1e-3 * (hi - lo) else None
 
 
 def _warm(fits: list[Fit], names: set[str]) -> dict:
@@ -700,20 +710,14 @@ def _as_catalog(f: Fit, vehicle: str) -> hypotheses.Hypothesis | None:
     when there is none."""
     laws, changed = [], False
     for law in f.hyp.laws:
-        shape = [p for p in law.params if p.removesuffix(".A").removesuffix(".B") in SHAPE_KEYS]
-        low = [f.params.get(p, 0.0) <= _shape_lo(p) for p in shape]
-        if shape and all(low):
+        shape = [p for p in law.params if _is_shape(p)]
+        if shape and all(_shape_end(p, f.params.get(p, 0.0)) == "low" for p in shape):
             cat = hypotheses.catalog_law(law.family, vehicle)
             laws.append(cat if law.truck is None else cat.on(law.truck))
             changed = True
         else:
             laws.append(law)
     return hypotheses.Hypothesis(tuple(laws)) if changed else None
-
-
-def _shape_lo(key: str) -> float:
-    lo, hi, _ = hypotheses.bounds(key)
-    return lo + 1e-6 * (hi - lo)
 
 
 def _third(pair: Fit, singles, prob, fprs, sig_head, progress) -> list[Fit]:

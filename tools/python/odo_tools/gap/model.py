@@ -635,7 +635,7 @@ def accel_demand(prs: list, q: float = 99.0) -> float:
     for pr in prs:
         for t, drive in enumerate(pr.driven):
             if drive:
-                p = integrate(*floor_travel(pr, {}, t))
+                p = _track(pr, {}, t)  # the nominal track, cached: the fits ask for it too
                 v = np.diff(p[:, :2], axis=0) / pr.dt[:, None]
                 dv = np.diff(np.vstack([[0.0, 0.0], v]), axis=0)
                 a.append(np.hypot(dv[:, 0], dv[:, 1]) / pr.dt * 1e-3)
