@@ -22,25 +22,33 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .background import Background
-from .bumps import clear_bumps, place_bumps
+from .bumps import clear_bumps, place_bumps, place_floor_bumps
 from .fit import Fit
 from .modes import TruthMode, wrap_rad
 
 HELDOUT_BUMP_MIN_RUNS = 2
 
 
-def apply(f: Fit | None, prs: list, min_runs: int = 1) -> dict:
+def apply(f: Fit | None, prs: list, min_runs: int = 1, items: list | None = None) -> dict:
     """Put the fit's effect on runs; `min_runs`: place only floor bumps seen in that many fitting
     runs. Held-out runs use 2: a bump found in one run only may belong to that run (rect-7x4 lays
     its bumps under alternating wheels from run to run), and predicting it where it is not adds
     a heading step the held-out run never had; a bump two runs of the path agree on is a floor
-    feature."""
+    feature, and so is one that runs of several paths met at one spot of the floor (`items`: the
+    runs' truth tracks, which show where their wheels pass; bumps.place_floor_bumps)."""
     clear_bumps(prs)
     if f is None:
         return {}
     if f.bumps:
         place_bumps(prs, [b for b in f.bumps if len(b.get("runs", [])) >= min_runs])
+        if items is not None and min_runs > 1:
+            place_floor_bumps(items, f.bumps, min_runs)
     return f.model_params()
+
+
+def tracked(items: list) -> list | None:
+    """The runs' truth tracks, when they have them (truth mode)."""
+    return items if items and all(isinstance(it, TruthMode) for it in items) else None
 
 
 @dataclass
@@ -188,7 +196,7 @@ def evaluate(
 ) -> HeldOut:
     """Before (nominal) and after (`f`, None = nominal) on the held-out runs."""
     hprs = [prs[i] for i in held]
-    P = apply(f, hprs, HELDOUT_BUMP_MIN_RUNS)
+    P = apply(f, hprs, HELDOUT_BUMP_MIN_RUNS, tracked([items[i] for i in held]))
     after = [run_gap(items[i], P, sigma, bg)[0] for i in held]
     clear_bumps(hprs)
     res = [run_gap(items[i], {}, sigma, bg) for i in held]
