@@ -38,7 +38,7 @@ def test_a_spot_two_paths_met_is_placed_where_a_held_out_track_crosses_it() -> N
     bumps.place_floor_bumps([held], floor, min_runs=2)
     assert len(held.pr.bumps) == 1
     b = held.pr.bumps[0]
-    assert (b["truck"], b["wheel"]) == (0, 1)  # the right wheel passes the spot, the left 400 mm off
+    assert (b["truck"], b["wheel"]) == (0, 1)  # the right wheel passes it, the left 400 mm off
     assert b["s0"] == pytest.approx(1200.0, abs=15.0)  # the closest sample to the feature's spot
     assert b["h"] == pytest.approx(10.0)  # the members' median
 
@@ -102,7 +102,7 @@ def test_a_floor_of_ramps_under_slow_wheels_is_named_bumps(tmp_path: Path) -> No
     the 0.5 s detector saw at 40 % under 0.2 deg of truth noise: nothing was detected, Es won
     and the held-out runs kept 41 x the background ("unexplained"). Wider windows find it in
     four runs of four paths at one spot of the floor, and the held-out runs meet it there."""
-    c, rep = indep_named(2731, 22, tmp_path, "labmate", {"bumps": "ramps"}, "bumps", "catalog")
+    _, rep = indep_named(2731, 22, tmp_path, "labmate", {"bumps": "ramps"}, "bumps", "catalog")
     hd = rep["heldout"]
     assert hd["ratio_after"] < 0.6 * hd["ratio_before"]
 
@@ -112,6 +112,6 @@ def test_bumps_alone_are_detected_under_the_best_other_single_too(tmp_path: Path
     model the detector missed bumps that it found under the best other single (an Ed of 0.9994),
     where the pairs look; a slip of next to nothing beside those beat bumps alone by them
     ("bumps+slip"). The single is fitted with that detection too and keeps the better."""
-    c, rep = indep_named(2721, 27, tmp_path, "labmate", {"bumps": "ramps"}, "bumps", "catalog")
+    _, rep = indep_named(2721, 27, tmp_path, "labmate", {"bumps": "ramps"}, "bumps", "catalog")
     hd = rep["heldout"]
     assert hd["ratio_after"] < 0.3 * hd["ratio_before"]
