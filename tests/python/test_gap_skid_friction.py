@@ -11,7 +11,7 @@ from types import SimpleNamespace
 
 import numpy as np
 import pytest
-from gap_support import BUILD, SRC, indep_named
+from gap_support import BUILD, SRC, indep_case, indep_named
 
 
 @pytest.fixture(autouse=True)
@@ -103,6 +103,34 @@ def test_a_wheelbase_under_lateral_load_is_named_eb_alone(tmp_path: Path) -> Non
     e = c["true"]["effects"]["eb"]
     assert v["params"]["eb.value"] == pytest.approx(e["value0"], abs=0.001)
     assert v["params"]["eb@load.zeta"] == pytest.approx(e["zeta"], abs=0.06)
+
+
+def test_a_clappers_wheelbase_under_load_is_named_from_its_tracks(tmp_path: Path) -> None:
+    """Independent world, seed 2721 case 12: a clapper on 10 ms ticks whose wheelbase is 0.981
+    on the spot and grows 12 % of the lateral acceleration in g. The windows' ranking left its
+    tracks far from the background, and the refit on the accumulated tracks knew only the
+    catalog's laws: "eb+scrub" (Eb 0.994 beside a scrub of -0.013). With the load law among the
+    track fit's singles it is the Eb alone, both numbers within a few per mille."""
+    c, rep = indep_named(2721, 12, tmp_path, "clapper", {"eb": "load_patch"}, "eb", "load")
+    v = rep["verdict"]
+    e = c["true"]["effects"]["eb"]
+    assert v["params"]["eb.value"] == pytest.approx(e["value0"], abs=0.001)
+    assert v["params"]["eb@load.zeta"] == pytest.approx(e["zeta"], abs=0.02)
+    assert rep["heldout"]["ratio_after"] < 2.0
+
+
+def test_a_track_fit_member_that_stopped_earning_its_place_goes(tmp_path: Path) -> None:
+    """Independent world, seed 2721 case 21: a LabMate's tyre compression, which the catalog
+    reports through Ed and Es. Among the track fit's singles the load law led, Ed and Es joined
+    it, and it ended at zeta 0.005 with Eb 0.99995 - a member doing nothing ("eb+ed+es"). Each
+    member must still halve what is left without it (diagnose._track_prune): ed + es."""
+    from odo_tools.gap.diagnose import diagnose
+
+    real = tmp_path / "real"
+    indep_case(2721, 21, real, "labmate", {"tire_compression": "linear"})
+    rep = diagnose(real, real / "robot.json", mode="truth").to_dict()
+    assert rep["verdict"]["effect"] == "ed+es", rep["verdict"]
+    assert rep["heldout"]["ratio_after"] < 0.05 * rep["heldout"]["ratio_before"]
 
 
 def test_a_load_law_at_either_end_of_its_range_is_no_candidate() -> None:
