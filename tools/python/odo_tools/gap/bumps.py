@@ -279,15 +279,15 @@ def floor_features(floor_bumps: list[dict]) -> list[dict]:
 
 
 def place_floor_bumps(items: list, floor_bumps: list[dict], min_runs: int) -> None:
-    """Add to each truth-tracked run the floor bumps that runs of at least two other paths met at
-    one spot, where its own track takes a wheel over that spot the same way. The independent
-    world's cables lie where every path that crosses them meets them (2731 case 22: one ramp met
-    by four runs of four paths, none driven twice in the fit, so no path's runs agreed on it and
-    the held-out runs were judged without it). One path's bumps, however many of its runs agree,
-    say nothing of another path: the simulator lays them by wheel travel (2662 case 10 went
-    "unexplained" when a bump one run met was placed on every run crossing its spot). Bumps a
-    run's own path agrees on are placed by place_bumps (at their wheel travel) and not again
-    here."""
+    """Add to each truth-tracked run the floor bumps that fitting runs of at least two paths (its
+    own among them or not) met at one spot, where its own track takes a wheel over that spot the
+    same way. The independent world's cables lie where every path that crosses them meets them
+    (2731 case 22: one ramp met by four runs of four paths, none driven twice in the fit, so no
+    path's runs agreed on it and the held-out runs were judged without it). One path's bumps,
+    however many of its runs agree, say nothing of another path: the simulator lays them by
+    wheel travel (2662 case 10 went "unexplained" when a bump one run met was placed on every
+    run crossing its spot). Bumps a run's own path agrees on are placed by place_bumps (at their
+    wheel travel) and not again here."""
     for f in floor_features(floor_bumps):
         if len(f["runs"]) < min_runs or len({m["group"] for m in f["members"]}) < 2:
             continue
