@@ -306,7 +306,7 @@ def rank(ds: Dataset, sel: Selection, progress: Progress = None) -> Ranking:
         singles.append(fit_hypothesis(h, prob, fprs, sig_head))
     singles = [f for f in singles if _real(f)]
     singles.sort(key=lambda f: f.bic)
-    detected = _bumps_under_best(singles, prob, fprs, sig_head) if ds.mode == "truth" else None
+    detected = _bumps_under_best(singles, prob, fprs, sig_head)  # bumps: a truth-mode hypothesis
     slip = next((f for f in singles[:SLIP_EARLY] if "slip" in f.hyp.families), None)
     if slip is not None and ds.mode == "truth":
         # slip near the top while the truth was given latencies: ask before the pairs whether
@@ -713,10 +713,11 @@ def _bumps_under_best(singles: list[Fit], prob, fprs, sig_head) -> list | None:
 
 
 def _pairs(
-    singles, prob, fprs, sig_head, progress, vehicle: str, detected_best: list | None = None
+    singles, prob, fprs, sig_head, progress, vehicle: str, detected: list | None
 ) -> list[Fit]:
     """Pairs of the top singles (one law per family), and roughness with each of them;
-    `detected_best`: the floor bumps detected under `_bumps_ref`, when done already."""
+    `detected`: the floor bumps detected under `_bumps_ref` (`_bumps_under_best`; there is one
+    whenever a pair can hold bumps)."""
     top: list[Fit] = []
     for f in singles:
         if f.hyp.families[0] in ABSORBERS or any(t.hyp.families == f.hyp.families for t in top):
@@ -724,7 +725,6 @@ def _pairs(
         top.append(f)
         if len(top) == N_PAIR_BASE:
             break
-    detected: dict[str, list] = {} if detected_best is None else {"best": detected_best}
 
     def bumps_for(other: Fit) -> list | None:
         """Floor bumps for a pair with bumps. Next to a partner that only drifts (ed) or moves
@@ -734,10 +734,7 @@ def _pairs(
         pairs share one detection under the best single other than bumps and roughness."""
         if other.hyp.families[0] in BUMPS_REUSE_WITH:
             return next((f.bumps for f in singles if f.name == "bumps"), None)
-        if "best" not in detected:
-            ref = _bumps_ref(singles)
-            detected["best"] = cluster_bumps(detect_bumps(prob.items, ref.model_params(), sig_head))
-        return detected["best"]
+        return detected
 
     pairs = list(itertools.combinations(top, 2))
     absorbers = [f for f in singles if f.hyp.families[0] in ABSORBERS]
