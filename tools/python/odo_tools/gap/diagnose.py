@@ -280,8 +280,7 @@ def rank(ds: Dataset, sel: Selection, progress: Progress = None) -> Ranking:
         # shows only through its mean, which shortens every turn like an Eb (its alias; the
         # report lists it under "not identifiable")
         hyps = [h for h in hyps if "roughness" not in h.families]
-    for fam in [*hypotheses.ALWAYS, *(f for f in proposals if f not in hypotheses.ALWAYS)]:
-        hyps += hypotheses.other_laws(fam, ds.mode, ds.robot.vehicle)
+    hyps += hypotheses.tried_laws(proposals, ds.mode, ds.robot.vehicle)
     trucks = truck_excess(prob.items, {}, prob.sigma) if ds.robot.n_trucks == 2 else []
     scoped = None
     if trucks and max(trucks) >= hypotheses.TRUCK_SHARE:
