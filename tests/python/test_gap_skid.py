@@ -64,8 +64,9 @@ def test_the_cornering_law_is_tried_unproposed_and_the_friction_circle_only_on_a
     """hypotheses.tried_laws: without a proposal a ranking fits the load law and the cornering
     skid beside the catalog's laws, not the friction circle (it limits starts as well as
     turns); arcs that hold the misfit bring it; returns mode, which cannot see a skid, gets
-    none of them; a proposed family brings every one of its laws."""
-    from odo_tools.gap.hypotheses import tried_laws
+    none of them; a proposed family brings every one of its laws. An unproposed law is no
+    partner (hypotheses.unproposed)."""
+    from odo_tools.gap.hypotheses import tried_laws, unproposed
 
     def names(proposals: dict, mode: str = "truth", vehicle: str = "labmate") -> list[str]:
         return [h.name for h in tried_laws(proposals, mode, vehicle)]
@@ -73,6 +74,11 @@ def test_the_cornering_law_is_tried_unproposed_and_the_friction_circle_only_on_a
     assert names({}) == ["eb@load", "skid@cornering"]
     assert names({"skid": "arcs"}) == ["eb@load", "skid@cornering", "skid@friction"]
     assert "skid@cornering" not in names({}, "returns")
+    # unproposed, the cornering law may lead alone but joins no pair (2721 case 13: "ed+skid")
+    laws = {h.name: h for h in tried_laws({}, "truth", "set")}
+    assert unproposed(laws["skid@cornering"], {})
+    assert not unproposed(laws["skid@cornering"], {"skid": "arcs"})
+    assert not unproposed(laws["eb@load"], {})
     assert names({"slip": "starts"}, "returns") == [
         "eb@load",
         "slip@accel",

@@ -325,14 +325,15 @@ def rank(ds: Dataset, sel: Selection, progress: Progress = None) -> Ranking:
     gap = null.bic - best.bic >= DBIC_SIGNIFICANT or (gof is not None and gof >= Z_GAP)
     # pairs, unless the best single already leaves nothing but background on the fitting runs'
     # tracks (truth mode): most robots have one effect, and ten pair fits cost more than the rest
+    partners = [f for f in singles if not hypotheses.unproposed(f.hyp, proposals)]
     if gap and not (ds.mode == "truth" and _track_ratio(best, prob, ds, sel) <= R_WITHIN):
-        cands += _pairs(singles, prob, fprs, sig_head, progress, ds.robot.vehicle, detected)
+        cands += _pairs(partners, prob, fprs, sig_head, progress, ds.robot.vehicle, detected)
     cands.sort(key=lambda f: f.bic)
     c_hat = max(1.0, best.chi / max(prob.e0 - best.k, 1))
     pair = next((f for f in cands if f.hyp is not None and len(f.hyp.families) == 2), None)
     if pair is not None and _more(best, pair, prob, ds, sel):
         best = pair
-        third = _third(best, singles, prob, fprs, sig_head, progress)
+        third = _third(best, partners, prob, fprs, sig_head, progress)
         cands += third
         cands.sort(key=lambda f: f.bic)
         # the best triple, not the first of them that beats the pair: on the OptiOdom runs
