@@ -53,6 +53,7 @@ from .paths import assign_paths, assign_shapes, group_key, motion_kind
 from .report import Context, Report
 from .select import Selection, explicit, parse_groups, stratified
 from .stability import analyse as stability
+from .stability import drift
 from .verdict import R_GAP, R_WITHIN, decide
 from .where import phase_excess, truck_excess, where_analysis
 
@@ -1005,8 +1006,19 @@ def _diagnose(
     group_fits, findings = stability(
         fit_items, fit_prs, ds.mode, rk.prob.sigma, stab_fit, ds.groups
     )
-    chans = ds.items[0].channels()
     named = jd.verdict not in ("no significant gap", "unexplained")
+    moved = (
+        drift(ds.items, ds.prs, rk.prob.sigma, rk.best) if named and ds.mode == "truth" else None
+    )
+    if moved is not None:
+        findings.insert(0, moved)
+        jd.reason = (
+            f"{jd.verdict} fits the held-out runs ({jd.held.ratio_before:.2f} -> "
+            f"{jd.held.ratio_after:.2f} x the background), but its {moved.text}"
+        )
+        jd.verdict = "unexplained"
+        named = False
+    chans = ds.items[0].channels()
     where = where_analysis(ds.items, ds.prs, rk.best if named else None, chans, rk.prob.sigma)
     rep = Report.build(ds, sel, rk, jd, where, group_fits, findings)
     rep.elapsed_s = time.perf_counter() - t0

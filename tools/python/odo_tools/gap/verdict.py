@@ -17,6 +17,11 @@ R_WITHIN = 1.5  # after the fit, within 1.5 x the background: the effect is name
 EXCESS_REMOVED = 0.75  # ... or it removes this share of the held-out misfit above background
 
 
+# truth mode: the named geometry fitted run by run differs between the runs before and after one
+# moment by this many standard errors: a parameter drifting in time, which no catalog effect is
+# (stability.drift), and the verdict is "unexplained"
+DRIFT_Z = 4.0
+
 GAP_QUANTILE = 0.99  # a background estimated from few runs: R^2 beyond F(n, dof)'s 99 %
 
 
@@ -74,4 +79,5 @@ THRESHOLDS = {
     "heldout_ratio_named": R_WITHIN,
     "heldout_excess_removed_named": EXCESS_REMOVED,
     "heldout_gap_quantile_few_dof": GAP_QUANTILE,
+    "geometry_drift_z": DRIFT_Z,
 }
