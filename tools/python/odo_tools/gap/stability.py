@@ -166,7 +166,7 @@ def drift(items: list, prs: list[Prepared], sigma: np.ndarray, verdict: Fit) -> 
         per.append((prs[i], P, {k: v * math.sqrt(c) for k, v in se.items()}))
     best = None
     for k in keys:
-        runs = [(pr, P[k], se[k]) for pr, P, se in per if math.isfinite(se.get(k, math.nan))]
+        runs = [(pr, P[k], se[k]) for pr, P, se in per if 0.0 < se.get(k, math.nan) < math.inf]
         for j in range(1, len(runs)):
             # the same paths on both sides: a law that depends on the path (a trailer's tyre
             # deflection, 2721 case 57: four circles, then a square) is no drift in time
