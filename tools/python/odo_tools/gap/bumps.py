@@ -152,12 +152,7 @@ def detect_bumps(items: list, P: dict, sigma_head: float) -> list[dict]:
                 e = e - _signed_excess(pr, truck, w, x[0], x[1])[tick_all]
                 Ds = [_step_detector(e, mm) for mm in ms]
                 j = int(np.clip(np.searchsorted(Sa[w], x[1]), 0, tt.size - 1))
-                th = it.tpose[j, truck, 2]
-                half = (0.5 if w == 0 else -0.5) * pr.b[truck]
-                xy = (
-                    it.tpose[j, truck, 0] - half * math.sin(th),
-                    it.tpose[j, truck, 1] + half * math.cos(th),
-                )
+                xy = _contact(it.tpose[j, truck], w, pr.b[truck])
                 events.append(
                     {
                         "run": pr.run.name,
@@ -174,6 +169,14 @@ def detect_bumps(items: list, P: dict, sigma_head: float) -> list[dict]:
                     }
                 )
     return events
+
+
+def _contact(pose: np.ndarray, wheel: int, b: float) -> tuple:
+    """Where a wheel (0 left, 1 right) of a truck at pose (..., 3: x, y, heading) touches the
+    floor: half the wheelbase to its side of the truck's tracked centre."""
+    half = (0.5 if wheel == 0 else -0.5) * b
+    th = pose[..., 2]
+    return pose[..., 0] - half * np.sin(th), pose[..., 1] + half * np.cos(th)
 
 
 def _rolling(it, truck: int, wheel: int, j: int) -> float:
@@ -299,13 +302,9 @@ def place_floor_bumps(items: list, floor_bumps: list[dict], min_runs: int) -> No
             if any(m["group"] == g and len(m.get("runs", ())) >= min_runs for m in f["members"]):
                 continue
             t = f["truck"]
-            th = it.tpose[:, t, 2]
             for w in (0, 1):
-                half = (0.5 if w == 0 else -0.5) * pr.b[t]
-                d = np.hypot(
-                    it.tpose[:, t, 0] - half * np.sin(th) - f["x_mm"],
-                    it.tpose[:, t, 1] + half * np.cos(th) - f["y_mm"],
-                )
+                cx, cy = _contact(it.tpose[:, t], w, pr.b[t])
+                d = np.hypot(cx - f["x_mm"], cy - f["y_mm"])
                 near = d < FLOOR_TOL_MM
                 # one bump per pass: each run of samples near the spot, at its closest sample,
                 # where the wheel rolls the way the runs that met it did and meets no bump the
