@@ -190,9 +190,7 @@ def drift(items: list, prs: list[Prepared], sigma: np.ndarray, verdict: Fit) -> 
                 best.implies = {"runs_before": len(early), "runs_after": len(late)}
     if best is None or best.z < DRIFT_Z:
         return None
-    what = {"ed.value": "Ed", "eb.value": "Eb", "es.value": "Es"}.get(
-        best.param.rsplit(".", 1)[0] if best.param.count(".") > 1 else best.param, best.param
-    )
+    what = _what(best.param)
     best.text = (
         f"{what} drifts with time: {best.values[0]:.4f} +- {best.stderr[0]:.4f} on "
         f"{best.implies['runs_before']} run(s) up to '{best.groups[0]}', {best.values[1]:.4f} +- "
@@ -201,6 +199,20 @@ def drift(items: list, prs: list[Prepared], sigma: np.ndarray, verdict: Fit) -> 
         "it constant"
     )
     return best
+
+
+NAMES = {
+    "eb.value": "effective wheelbase (Eb)",
+    "ed.value": "wheel-diameter ratio (Ed)",
+    "es.value": "scale (Es)",
+    "scrub.k": "scrub coefficient k",
+}
+
+
+def _what(param: str) -> str:
+    """A parameter in words; a truck's own copy ('ed.value.A') with its truck."""
+    base, _, truck = param.rpartition(".") if param.count(".") > 1 else (param, "", "")
+    return f"{NAMES[base]} of truck {truck}" if base in NAMES and truck else NAMES.get(base, param)
 
 
 def _wmean(runs: list) -> tuple[float, float]:
@@ -215,12 +227,7 @@ def _words(fd: Finding, prs: list[Prepared], kinds: dict[str, list[str]]) -> str
     as tyre scrub, with the k it implies (catalog scrub: Eb_arc = Eb_spot / (1 - k (1 - s)),
     s = b / (2R))."""
     (ga, gb), (va, vb) = fd.groups, fd.values
-    what = {
-        "eb.value": "effective wheelbase (Eb)",
-        "ed.value": "wheel-diameter ratio (Ed)",
-        "es.value": "scale (Es)",
-        "scrub.k": "scrub coefficient k",
-    }.get(fd.param, fd.param)
+    what = _what(fd.param)
     text = (
         f"{what} {va:.4f} +- {fd.stderr[0]:.4f} on {fd.kind} '{ga}' but {vb:.4f} +- "
         f"{fd.stderr[1]:.4f} on '{gb}' ({fd.z:.1f} standard errors apart)"
