@@ -178,3 +178,35 @@ def test_a_linkage_bias_is_not_traded_for_geometry_the_tracks_prefer(tmp_path: P
     assert v["effect"] == "rotary_bias", v
     a = c["params"]["rotary_bias.alpha_deg"]
     assert abs(v["params"]["rotary_bias.alpha_deg"] - a) < 0.05 * abs(a), (v["params"], a)
+
+
+def test_a_second_parameter_must_halve_what_a_simpler_law_leaves(tmp_path: Path) -> None:
+    """Independent world, dev seed 2731 case 21: a LabMate whose wheelbase follows the inverse
+    turn radius (k = 0.0212). Fitted to the tracks, the catalog scrub leaves 1.86 x the
+    background and the load law's two parameters 1.72 x; taken for that, the load law sent the
+    held-out oval (driven the other way) to 184 x ("unexplained"). A second parameter must
+    halve the excess like a further member (diagnose._track_simplest)."""
+    real = tmp_path / "real"
+    indep_case(2731, 21, real, "labmate", {"scrub": "inv_radius"})
+    rep = D.diagnose(real, real / "robot.json", mode="truth").to_dict()
+    assert rep["verdict"]["effect"] == "scrub", rep["verdict"]
+    assert rep["verdict"]["params"]["scrub.k"] == pytest.approx(0.0212, rel=0.1)
+    assert "scrub fitted to the tracks" in rep["proposals"]["the accumulated track"]
+
+
+@pytest.mark.parametrize(
+    ("ratios", "chosen"),
+    [
+        ((1.86, 1.72), "scrub"),  # 2731 case 21: 2.46 -> 1.96 of excess, not halved
+        ((1.86, 1.20), "eb@load"),  # halved: the second parameter earns its place
+        ((0.90, 0.50), "scrub"),  # nothing above the background to halve
+    ],
+)
+def test_track_simplest(ratios: tuple, chosen: str) -> None:
+    from odo_tools.gap import hypotheses as H
+
+    hyps = [H.Hypothesis((H.catalog_law("scrub", "labmate"),))]
+    hyps += [h for h in H.other_laws("eb", "truth", "labmate") if h.name == "eb@load"]
+    fits = [type("F", (), {"hyp": h, "name": h.name})() for h in hyps]
+    best, r = D._track_simplest(fits, list(ratios))
+    assert best.name == chosen and r == ratios[[f.name for f in fits].index(chosen)]
