@@ -210,3 +210,18 @@ def test_track_simplest(ratios: tuple, chosen: str) -> None:
     fits = [type("F", (), {"hyp": h, "name": h.name})() for h in hyps]
     best, r = D._track_simplest(fits, list(ratios))
     assert best.name == chosen and r == ratios[[f.name for f in fits].index(chosen)]
+
+
+def test_a_member_the_tracks_do_not_need_leaves_the_pair(tmp_path: Path) -> None:
+    """Independent world, dev seed 2761 case 28: a set whose trailer's wheels differ (Ed
+    0.99846 on truck B). The windows ranked a motor-law slip first and took "ed + slip" from it
+    (Delta qBIC -0.1, accepted on the tracks: 13.1 -> 4.9 x the background). Without the slip
+    the tracks stay where they were, so it leaves (diagnose._prune_members) and the verdict is
+    the trailer's Ed."""
+    real = tmp_path / "real"
+    indep_case(2761, 28, real, "set", {"ed": "fixed"})
+    rep = D.diagnose(real, real / "robot.json", mode="truth").to_dict()
+    v = rep["verdict"]
+    assert v["effect"] == "ed", v
+    assert v["params"]["ed.value.B"] == pytest.approx(0.99846, abs=3e-4)
+    assert "the rest is not needed there" in rep["proposals"]["the accumulated track"]

@@ -156,6 +156,11 @@ def drift(items: list, prs: list[Prepared], sigma: np.ndarray, verdict: Fit) -> 
     keys = [k for k in base if k.split(".")[0] in DRIFTING]
     if not keys or verdict.bumps or len(prs) < 3:
         return None
+    if not any(k.split(".")[0] == "es" for k in keys):
+        # the mean diameter beside a verdict without it: a wheel that warms shows there first,
+        # and a constant Es the fitting tracks did not need left the verdict ("ed" alone on
+        # 2761 case 43, diagnose._prune_members) without the wheel holding still
+        keys.append("es.value")
     order = sorted(range(len(prs)), key=lambda i: float(prs[i].t[0]))
     per = []
     for i in order:
