@@ -644,7 +644,7 @@ def accel_demand(prs: list, q: float = 99.0) -> float:
 
 # effects on the linkage encoders' readings only: the trucks' tracks do not depend on them, so a
 # fit of them reuses the cached tracks instead of dead-reckoning again for every step
-SENSOR_ONLY = ("rotary_bias.", "link_bias.")
+SENSOR_ONLY = ("rotary_bias.", "rotary_bias@", "link_bias.")
 # effects floor_travel applies to driven trucks only (world.c step_driven)
 DRIVE_ONLY = ("slip.", "slip@", "skid.", "skid@", "scrub.")
 
@@ -790,13 +790,24 @@ def _clamp_push(pa: np.ndarray, pb: np.ndarray, lo: float, hi: float, gate) -> n
 
 
 def link_bias(P: dict, alpha: np.ndarray, beta: np.ndarray) -> tuple:
-    """What rotary_bias / link_bias add to the true linkage readings (deg, deg, mm)."""
-    ba = P.get("rotary_bias.alpha_deg", 0.0)
-    bb = P.get("rotary_bias.beta_deg", 0.0)
+    """What rotary_bias / link_bias add to the true linkage readings (deg, deg, mm). A rotary
+    encoder's offset may vary once per turn of its shaft (`rotary_bias@eccentric`: a disc
+    mounted off centre), b0 + s sin(angle) + c (cos(angle) - 1), zero-referenced to the
+    straight link like the constant offset it extends."""
+    ba = P.get("rotary_bias.alpha_deg", 0.0) + _once_per_turn(P, "alpha", alpha)
+    bb = P.get("rotary_bias.beta_deg", 0.0) + _once_per_turn(P, "beta", beta)
     bl = P.get("link_bias.const_mm", 0.0) + P.get("link_bias.ecc_mm", 0.0) * (
         1 - np.cos(alpha - beta)
     )
     return ba, bb, bl
+
+
+def _once_per_turn(P: dict, joint: str, angle):
+    s = P.get(f"rotary_bias@eccentric.{joint}_sin_deg", 0.0)
+    c = P.get(f"rotary_bias@eccentric.{joint}_cos_deg", 0.0)
+    if s == 0.0 and c == 0.0:
+        return 0.0
+    return s * np.sin(angle) + c * (np.cos(angle) - 1.0)
 
 
 def wrap_deg(a: np.ndarray) -> np.ndarray:

@@ -333,9 +333,9 @@ class TruthMode:
                 d = m[:, c] + 0.5 * step - x  # the cell's centre against the measured truth
                 return wrap_rad(d) if angle else d
 
-            ra = res(0, tl[:, 0] + math.radians(ba), self.step_rad, True)
+            ra = res(0, tl[:, 0] + np.radians(ba), self.step_rad, True)
             if self.robot.vehicle == "clapper":
-                rb = res(1, tl[:, 1] + math.radians(bb), self.step_rad, True)
+                rb = res(1, tl[:, 1] + np.radians(bb), self.step_rad, True)
                 rl = res(2, tl[:, 2] + bl, self.step_l_mm, False)
                 cols.append(np.column_stack([ra, rb, rl]))
             else:
@@ -609,11 +609,15 @@ class LinkageMode:
         pa, pb = dead_reckon(self.pr, P, 0), dead_reckon(self.pr, P, 1)
         i, j = self.i, self.j
         ia, ib = _body_inc(pa, i, j), _body_inc(pb, i, j)
-        ba, bb, _ = link_bias(P, 0.0, 0.0)
-        a0 = wrap_rad(self.a[i] - math.radians(ba))
+        # the offsets at the read angles of both ends: an offset that varies once per turn of
+        # the shaft (rotary_bias@eccentric) changes by far less between the read and the true
+        # angle than between the two ends; a constant one is the same at both
+        ba, bb, _ = link_bias(P, self.a[i], self.b[i] if self.clapper else 0.0)
+        ea, eb_, _ = link_bias(P, self.a[j], self.b[j] if self.clapper else 0.0)
+        a0 = wrap_rad(self.a[i] - np.radians(ba))
         xa, ya, tha = ia[:, 0], ia[:, 1], ia[:, 2]  # A starts at the origin, heading 0
         if self.clapper:
-            b0 = wrap_rad(self.b[i] - math.radians(bb))
+            b0 = wrap_rad(self.b[i] - np.radians(bb))
             l0 = self.l[i] - self._lbias(P, a0, b0)
             thl = -a0
             xb0, yb0 = -l0 * np.cos(thl), -l0 * np.sin(thl)
@@ -624,8 +628,8 @@ class LinkageMode:
             thl1 = np.arctan2(ya - yb, xa - xb)
             a1, b1 = wrap_rad(tha - thl1), wrap_rad(thb - thl1)
             l1 = np.hypot(xa - xb, ya - yb)
-            pa_ = a1 + math.radians(ba)
-            pb_ = b1 + math.radians(bb)
+            pa_ = a1 + np.radians(ea)
+            pb_ = b1 + np.radians(eb_)
             pl = l1 + self._lbias(P, a1, b1)
             return np.column_stack(
                 [wrap_rad(self.a[j] - pa_), wrap_rad(self.b[j] - pb_), self.l[j] - pl]
@@ -641,7 +645,7 @@ class LinkageMode:
         dx, dy = hx - xt, hy - yt
         along = np.hypot(dx, dy) - L
         perp = wrap_rad(np.arctan2(dy, dx) - tht) * L
-        pa_ = wrap_rad(tha - tht) + math.radians(ba)
+        pa_ = wrap_rad(tha - tht) + np.radians(ea)
         return np.column_stack([wrap_rad(self.a[j] - pa_), along, perp])
 
     @staticmethod
