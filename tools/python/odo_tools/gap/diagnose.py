@@ -652,7 +652,7 @@ def _bumps_on_tracks(ds: Dataset, sel: Selection, rk: Ranking, progress: Progres
     """Truth mode: floor bumps judged on the fitting runs' accumulated tracks. A 0.4 s window
     sees a bump's heading step once, and the windows' BIC charges each bump two parameters, so
     bumps that the tracks plainly want can rank below a smooth effect that soaks up the
-    windows (independent world, dev seed 2741 case 54: a set's bumps, 28.6 BIC better than
+    windows (independent world, dev seed 2741 case 54: a clapper's bumps, 28.6 BIC better than
     nominal, ranked below es + link bias + slip, which left the fitting tracks at 40 x the
     background against 36 x nominally; the bumps single leaves 3.3 x). The bumps single
     replaces the best when the nominal tracks show a gap (R >= R_GAP) that the best leaves
