@@ -52,6 +52,8 @@ LAW_WORDS = {
     "Eb (1 + zeta |a_lat| / g)",
     "friction": "friction circle: the truck's centre changes its velocity by at most a_lim; "
     "beyond it (fast turns) the centre falls behind the wheels' path while the heading follows",
+    "eccentric": "a joint encoder's offset that varies once per turn of its shaft (a disc "
+    "mounted off centre): b0 + s sin(angle) + c (cos(angle) - 1)",
 }
 # effects a parameter block corrects (odo-calib): what a next step can fix on the robot
 KINEMATIC = ("ed", "eb", "es", "scrub")
@@ -85,6 +87,8 @@ def unit(key: str) -> str:
             "a_lim_m_s2": "m/s^2",
             "zeta": "1",
         }.get(p, "")
+        if p.endswith("_deg"):  # the once-per-turn terms of a joint encoder's offset
+            u = "deg"
     return "" if u in ("1", "-") else u
 
 
