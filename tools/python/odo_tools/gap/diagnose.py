@@ -509,16 +509,34 @@ def _track_fit(hyp: hypotheses.Hypothesis, tp: TrackProblem, prob: Problem, warm
 def _track_prune(
     best: Fit, rbest: float, tp: TrackProblem, prob: Problem, warm: dict
 ) -> tuple[Fit, float]:
-    """Members of the track fit's result that no longer earn their place once the others joined:
-    one whose removal leaves the tracks' excess (R^2 - 1) below 1 / TRACK_MEMBER_CUT times what
-    it is with it goes, the way a member joins. A load law that led the singles (a LabMate's tyre
-    compression, 2721 case 21) ended at zeta 0.005 beside the Ed and Es that joined it."""
+    """Members of the track fit's result that no longer earn their place once the others joined
+    (`_drop_members`). A load law that led the singles (a LabMate's tyre compression, 2721 case
+    21) ended at zeta 0.005 beside the Ed and Es that joined it."""
+
+    def refit(h: hypotheses.Hypothesis, cur: Fit) -> tuple[float, Fit]:
+        g = _track_fit(h, tp, prob, {**warm, **cur.model_params()})
+        return tp.ratio(g.model_params()), g
+
+    return _drop_members(best, rbest, refit)
+
+
+def _drop_members(best: Fit, rbest: float, refit, keep: tuple = ()) -> tuple[Fit, float]:
+    """Take members out of `best` (track ratio `rbest`) while one no longer earns its place on
+    the tracks: the one whose removal leaves the least, when that leaves the tracks' excess
+    (R^2 - 1) within 1 / TRACK_MEMBER_CUT of what it is with it - the rule by which a member
+    joins a track fit. `refit(h, best)`: (track ratio, fit) of the hypothesis without one
+    member, or None; families in `keep` stay."""
     while len(best.hyp.laws) > 1:
         drops = []
         for law in best.hyp.laws:
+            if law.family in keep:
+                continue
             h = hypotheses.Hypothesis(tuple(x for x in best.hyp.laws if x is not law))
-            g = _track_fit(h, tp, prob, {**warm, **best.model_params()})
-            drops.append((tp.ratio(g.model_params()), g))
+            got = refit(h, best)
+            if got is not None:
+                drops.append(got)
+        if not drops:
+            break
         r, g = min(drops, key=lambda x: x[0])
         if TRACK_MEMBER_CUT * max(r * r - 1.0, 0.0) > max(rbest * rbest - 1.0, 0.0):
             break
@@ -690,48 +708,38 @@ TRACK_BLIND = ("rotary_bias", "link_bias")
 
 
 def _prune_members(ds: Dataset, sel: Selection, rk: Ranking, progress: Progress = None) -> bool:
-    """Truth mode: a member of the windows' best pair or triple that the fitting runs' tracks
-    do not need leaves it - one whose removal leaves the tracks' excess misfit (R^2 - 1) within
-    1 / TRACK_MEMBER_CUT of what it is with it, the rule by which a member joins a track fit
-    (_track_prune). A slip that the windows took from an acceleration-phase misfit every robot
-    of the independent world shows rode along with the geometry that closed the tracks: a
-    LabMate's scrub became "scrub + slip" with the tracks at 8.4 x the background either way,
-    and a set's Ed "ed + slip" (dev seeds 2741 case 6, 2761 case 28). Linkage biases stay
-    (TRACK_BLIND). True where a member left."""
-    best = rk.best
-    if ds.mode != "truth" or best.hyp is None or len(best.hyp.laws) < 2:
+    """Truth mode: members of the windows' best pair or triple that the fitting runs' tracks do
+    not need leave it (`_drop_members`). A slip that the windows took from an acceleration-phase
+    misfit every robot of the independent world shows rode along with the geometry that closed
+    the tracks: a LabMate's scrub became "scrub + slip" with the tracks at 8.4 x the background
+    either way, and a set's Ed "ed + slip" (dev seeds 2741 case 6, 2761 case 28). Linkage
+    biases stay (TRACK_BLIND). True where a member left."""
+    first = rk.best
+    if ds.mode != "truth" or first.hyp is None or len(first.hyp.laws) < 2:
         return False
     fprs = [ds.prs[i] for i in sel.fit]
     sig_head = _sig_head(rk.prob, ds.items[0].channels())
-    rbest = _track_ratio(best, rk.prob, ds, sel)
-    left = False
-    while len(best.hyp.laws) > 1:
-        drops = []
-        for law in best.hyp.laws:
-            if law.family in TRACK_BLIND:
-                continue
-            h = hypotheses.Hypothesis(tuple(x for x in best.hyp.laws if x is not law))
-            g = next((f for f in rk.cands if f.hyp is not None and f.hyp.name == h.name), None)
-            if g is None:
-                if progress:
-                    progress(f"fitting {h.name} for the tracks")
-                fb = best.bumps if h.has_bumps else None
-                g = fit_hypothesis(h, rk.prob, fprs, sig_head, fb, best.model_params())
-                if not _real(g):
-                    continue
-            drops.append((_track_ratio(g, rk.prob, ds, sel), g))
-        if not drops:
-            break
-        r, g = min(drops, key=lambda x: x[0])
-        if TRACK_MEMBER_CUT * max(r * r - 1.0, 0.0) > max(rbest * rbest - 1.0, 0.0):
-            break
-        rk.proposals["the accumulated track"] = (
-            f"{best.name} leaves the fitting runs' tracks at {rbest:.2f} x the background and "
-            f"{g.name} at {r:.2f} x: the rest is not needed there"
-        )
-        best, rbest, left = g, r, True
-    rk.best = best
-    return left
+
+    def refit(h: hypotheses.Hypothesis, cur: Fit) -> tuple[float, Fit] | None:
+        g = next((f for f in rk.cands if f.hyp is not None and f.hyp.name == h.name), None)
+        if g is None:
+            if progress:
+                progress(f"fitting {h.name} for the tracks")
+            fb = cur.bumps if h.has_bumps else None
+            g = fit_hypothesis(h, rk.prob, fprs, sig_head, fb, cur.model_params())
+            if not _real(g):
+                return None
+        return _track_ratio(g, rk.prob, ds, sel), g
+
+    r0 = _track_ratio(first, rk.prob, ds, sel)
+    rk.best, r = _drop_members(first, r0, refit, TRACK_BLIND)
+    if rk.best is first:
+        return False
+    rk.proposals["the accumulated track"] = (
+        f"{first.name} leaves the fitting runs' tracks at {r0:.2f} x the background and "
+        f"{rk.best.name} at {r:.2f} x: the rest is not needed there"
+    )
+    return True
 
 
 def floor_walk(prob: Problem, vehicle: str, pool: list | None = None) -> Background:

@@ -146,21 +146,20 @@ OTHER_LAWS = {
             "rises at a to the ceiling + excess and back",
         ),
     ),
-}
-
-OTHER_LAWS["rotary_bias"] = (
-    Law(
-        "rotary_bias",
-        "eccentric",
-        tuple(
-            f"rotary_bias{p}"
-            for j in ("alpha", "beta")
-            for p in (f".{j}_deg", f"@eccentric.{j}_sin_deg", f"@eccentric.{j}_cos_deg")
+    "rotary_bias": (
+        Law(
+            "rotary_bias",
+            "eccentric",
+            tuple(
+                f"rotary_bias{p}"
+                for j in ("alpha", "beta")
+                for p in (f".{j}_deg", f"@eccentric.{j}_sin_deg", f"@eccentric.{j}_cos_deg")
+            ),
+            "a joint encoder's offset that varies once per turn of its shaft (a disc mounted off "
+            "centre): b0 + s sin(angle) + c (cos(angle) - 1) on each joint angle",
         ),
-        "a joint encoder's offset that varies once per turn of its shaft (a disc mounted off "
-        "centre): b0 + s sin(angle) + c (cos(angle) - 1) on each joint angle",
     ),
-)
+}
 
 # the catalog count_loss acts through the decoder's clock (an HCTL filter), which the counts do
 # not show: its hypothesis is the generic law above
