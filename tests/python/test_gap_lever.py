@@ -55,3 +55,27 @@ def test_the_es_is_named_without_a_joint_encoder_offset(es_on_one_truck) -> None
     assert v["effect"] == "es", v
     (key,) = [k for k in v["params"] if k.startswith("es.value")]
     assert v["params"][key] == pytest.approx(c["true"]["effects"]["es"]["value"], abs=5e-4)
+
+
+@pytest.mark.parametrize(
+    "seed,k,laws",
+    [
+        (2781, 44, {"skid": "cornering"}),  # skid on truck B, both markers on their axles
+        (2761, 44, {"skid": "cornering"}),  # skid on truck A, B's marker 25 mm behind its axle
+    ],
+)
+def test_a_skidding_truck_is_not_read_as_its_marker_off_the_axle(tmp_path, seed, k, laws) -> None:
+    """On an arc a marker ahead of or behind the axle moves sideways as a skidding tyre does.
+    Without a skid in the preliminary fit the skidding truck's marker came out 56 mm (2781
+    case 44) and 102 mm (2761 case 44) behind its axle; with a skid on both trucks always, the
+    truck that does not skid had its real 25 mm offset taken for one (2761 case 44)."""
+    from odo_tools.gap import diagnose as D
+
+    real = tmp_path / "real"
+    c = indep_case(seed, k, real, "clapper", laws)
+    ds = D.load(real, real / "robot.json")
+    assert all("cornering skid" in n for n in ds.notes if "lever arm from" in n), ds.notes
+    lever = c["fidelity"]["truth_lever_arm_mm"]
+    for t, name in enumerate("AB"):
+        want = lever.get(name, [0.0, 0.0])
+        assert ds.instrument.lever_mm[t] == pytest.approx(want, abs=1.0), (name, ds.notes)
