@@ -25,6 +25,7 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 from threadpoolctl import threadpool_limits
@@ -177,29 +178,45 @@ def _lever_on_arcs(ds: Dataset) -> None:
     if "skid" in catalog.hypotheses("truth", ds.robot.vehicle):
         kc = "skid@cornering.deg_per_m_s2"
         each = [f"{kc}.{t}" for t in "AB"] if ds.robot.n_trucks > 1 else [kc]
-        sigma = best[3].sigma  # one noise scale for every choice
-        _, chi, n = Problem("truth", best[2], sigma).deviance(best[4])
+
+        def deviance(r: _Levers) -> tuple[float, float, int]:
+            return Problem("truth", r.items, best.sigma).deviance(r.P)  # one noise scale
+
+        dev, chi, n = deviance(best)
         c_hat = max(1.0, chi / n)  # the misfit the geometry leaves: overdispersion (Fit.qbic)
 
-        def qbic(r: tuple) -> float:
-            dev, _, n = Problem("truth", r[2], sigma).deviance(r[4])
-            return dev / c_hat + len(r[4]) * math.log(max(n, 2))
+        def qbic(r: _Levers, dev: float, n: int) -> float:
+            return dev / c_hat + len(r.P) * math.log(max(n, 2))
 
         # which trucks skid: each subset (a skid on one truck only took the other's marker,
         # 25 mm behind its axle, for a skid: dev 2761 case 44); by quasi-BIC, as plain BIC
         # took a skid on a set with slip, 21 below 36 000, and moved its marker 6 mm (2721
         # case 45, tests/python/test_gap_slip_motor.py)
-        cost = qbic(best)
+        cost = qbic(best, dev, n)
         for m in range(1, 1 << len(each)):
             r = _lever_rounds(ds, keys + [k for i, k in enumerate(each) if m >> i & 1])
-            if (c := qbic(r)) < cost:
+            dev, _, n = deviance(r)
+            if (c := qbic(r, dev, n)) < cost:
                 best, cost = r, c
-    ds.instrument, ds.notes, ds.items = best[:3]
+    ds.instrument, ds.notes, ds.items = best.inst, best.notes, best.items
 
 
-def _lever_rounds(ds: Dataset, keys: list[str]) -> tuple:
-    """`_lever_on_arcs` under one preliminary fit (keys): (instrument, notes, items, the last
-    round's problem, its fitted geometry); ds is not changed."""
+class _Levers(NamedTuple):
+    """Lever arms found under one preliminary fit (`_lever_rounds`)."""
+
+    inst: Instrument
+    notes: list[str]
+    items: list
+    sigma: np.ndarray  # the noise scale of the last round's problem
+    P: dict  # its fitted geometry
+
+
+def _lever_rounds(ds: Dataset, keys: list[str]) -> _Levers:
+    """`_lever_on_arcs` under one preliminary fit (keys); ds is not changed."""
+    skid = [k.rsplit(".", 1)[1] for k in keys if k.startswith("skid")]
+    basis = "Ed, Eb, Es, scrub and cornering skid" if skid else "Ed, Eb, Es and scrub"
+    if skid and ds.robot.n_trucks > 1:
+        basis += f" of truck{'s' if len(skid) > 1 else ''} {' and '.join(skid)}"
     inst = ds.instrument.copy()
     items = ds.items
     notes: list[str] = []
@@ -228,16 +245,12 @@ def _lever_rounds(ds: Dataset, keys: list[str]) -> tuple:
                     for pr in wt
                 }
                 inst.latency_s.update(instrument.session_latencies(wt, found))
-            sk = [k[-1] for k in keys if k.startswith("skid")]
-            skid = ", scrub and cornering skid" if sk else ""
-            if ds.robot.n_trucks > 1 and sk:
-                skid += f" of truck{'s' if len(sk) > 1 else ''} {' and '.join(sk)}"
             notes.append(
                 f"truck {'AB'[t]}: no turns on the spot: lever arm from {n} windows on arcs, "
-                f"under a preliminary fit of Ed, Eb, Es{skid or ' and scrub'}"
+                f"under a preliminary fit of {basis}"
             )
         items = [TruthMode(pr, ds.robot, inst) for pr in ds.prs]
-    return inst, notes, items, prob, P
+    return _Levers(inst, notes, items, prob.sigma, P)
 
 
 def recorded_accuracy(folders: list[Path]) -> tuple[float, float] | None:
