@@ -61,26 +61,28 @@ def test_cornering_skid_below_the_catalog_threshold_is_named(tmp_path: Path) -> 
 
 
 def test_the_cornering_law_is_tried_unproposed_and_the_friction_circle_only_on_arcs() -> None:
-    """hypotheses.tried_laws: without a proposal a ranking fits the load law and the cornering
-    skid beside the catalog's laws, not the friction circle (it limits starts as well as
-    turns); arcs that hold the misfit bring it; returns mode, which cannot see a skid, gets
-    none of them; a proposed family brings every one of its laws. An unproposed law is no
-    partner (hypotheses.unproposed)."""
+    """hypotheses.tried_laws: without a proposal a ranking fits the load law, the cornering
+    skid and Ed's speed law beside the catalog's laws, not the friction circle (it limits
+    starts as well as turns); arcs that hold the misfit bring it; returns mode, which cannot
+    see a skid, gets none of them; a proposed family brings every one of its laws. An
+    unproposed law is no partner (hypotheses.unproposed)."""
     from odo_tools.gap.hypotheses import tried_laws, unproposed
 
     def names(proposals: dict, mode: str = "truth", vehicle: str = "labmate") -> list[str]:
         return [h.name for h in tried_laws(proposals, mode, vehicle)]
 
-    assert names({}) == ["eb@load", "skid@cornering"]
-    assert names({"skid": "arcs"}) == ["eb@load", "skid@cornering", "skid@friction"]
+    assert names({}) == ["eb@load", "skid@cornering", "ed@growth"]
+    assert names({"skid": "arcs"}) == ["eb@load", "skid@cornering", "skid@friction", "ed@growth"]
     assert "skid@cornering" not in names({}, "returns")
     # unproposed, the cornering law may lead alone but joins no pair (2721 case 13: "ed+skid")
     laws = {h.name: h for h in tried_laws({}, "truth", "set")}
     assert unproposed(laws["skid@cornering"], {})
     assert not unproposed(laws["skid@cornering"], {"skid": "arcs"})
     assert not unproposed(laws["eb@load"], {})
+    assert unproposed(laws["ed@growth"], {})  # a tyre growing with speed leads alone, too
     assert names({"slip": "starts"}, "returns") == [
         "eb@load",
+        "ed@growth",
         "slip@accel",
         "slip@traction",
         "slip@motor",

@@ -679,6 +679,7 @@ def _track_refit(ds: Dataset, sel: Selection, rk: Ranking, progress: Progress = 
     # tracks at 1.19 x as Eb + scrub (independent world, 2721 case 12), the way the windows'
     # ranking named a LabMate's before the law joined (2721 case 10)
     singles += [h for h in hypotheses.other_laws("eb", "truth", ds.robot.vehicle) if "eb" in fams]
+    singles += [h for h in hypotheses.other_laws("ed", "truth", ds.robot.vehicle) if "ed" in fams]
     fits = []
     for h in singles:
         if progress:

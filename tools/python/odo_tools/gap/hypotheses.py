@@ -44,6 +44,7 @@ EXTRA_BOUNDS = {
     "skid@cornering.deg_per_m_s2": (0.0, 30.0, 1.0),
     "skid@friction.a_lim_m_s2": (0.05, 20.0, 2.0),
     "eb@load.zeta": (0.0, 1.0, 0.05),
+    "ed@growth.g_per_m2_s2": (-0.05, 0.05, 0.0),
     "rotary_bias@eccentric.alpha_sin_deg": (-10.0, 10.0, 0.0),
     "rotary_bias@eccentric.alpha_cos_deg": (-10.0, 10.0, 0.0),
     "rotary_bias@eccentric.beta_sin_deg": (-10.0, 10.0, 0.0),
@@ -83,6 +84,15 @@ def catalog_law(effect: str, vehicle: str) -> Law:
 
 # the other laws of a family (model.py implements each)
 OTHER_LAWS = {
+    "ed": (
+        Law(
+            "ed",
+            "growth",
+            ("ed.value", "ed@growth.g_per_m2_s2"),
+            "one tyre's rolling radius grows with the square of its speed (centrifugal growth): "
+            "r (1 + |g| v^2), the left tyre's for g > 0, the right's for g < 0, beside a fixed Ed",
+        ),
+    ),
     "eb": (
         Law(
             "eb",
@@ -265,7 +275,7 @@ PROPOSE = {
 # slip as a "skid" (2761 case 22). A joint encoder's offset that varies with the angle (a disc
 # off centre) shows in no phase either; as a constant it left a set's held-out runs at 2.8 x the
 # background (2741 case 40: 1.1 x once per turn), and it costs no dead reckoning
-ALWAYS = ("eb", "skid@cornering", "rotary_bias@eccentric")
+ALWAYS = ("eb", "skid@cornering", "rotary_bias@eccentric", "ed@growth")
 
 
 def unproposed(h: Hypothesis, proposals: dict) -> bool:

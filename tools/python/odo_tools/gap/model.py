@@ -187,6 +187,11 @@ def floor_travel(
     gl, gr = wheel_factors(P, R, b)
     ds[:, 0] *= gl
     ds[:, 1] *= gr
+    ge = P.get("ed@growth.g_per_m2_s2", 0.0)
+    if ge:
+        w = 0 if ge > 0 else 1
+        v = np.abs(pr.ds[:, truck, w]) / pr.dt * 1e-3  # m/s, from the counts
+        ds[:, w] *= 1.0 + abs(ge) * v * v
     hr = P.get("roughness.max_height_mm", 0.0)
     if hr > 0:
         m1, _ = rough_moments(R, hr)

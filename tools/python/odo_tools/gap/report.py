@@ -44,6 +44,8 @@ LAW_WORDS = {
     "motor": "traction saturation inside the tick: the motor takes each tick's speed with a lag "
     "tau, and the floor follows it by at most a_max",
     "speed": "a fraction of the counts lost above a wheel speed",
+    "growth": "one tyre's rolling radius grows with the square of its speed (centrifugal "
+    "growth): r (1 + |g| v^2), the left tyre for g > 0, the right for g < 0, beside a fixed Ed",
     "plateau": "a count-rate ceiling: the counts sit on a flat top while the hidden wheel speed "
     "rises beyond it and back",
     "cornering": "linear cornering stiffness: the tyres run at a slip angle proportional to the "
@@ -80,6 +82,7 @@ def unit(key: str) -> str:
             "a0_m_s2": "m/s^2",
             "a_max_m_s2": "m/s^2",
             "k_per_m_s": "1/(m/s)",
+            "g_per_m2_s2": "1/(m/s)^2",
             "v0_mm_s": "mm/s",
             "deg_per_m_s2": "deg/(m/s^2)",
             "excess_mm_s": "mm/s",
