@@ -274,7 +274,10 @@ PROPOSE = {
 # circle: it limits starts as well as turns, and tried on every robot it joined a LabMate's
 # slip as a "skid" (2761 case 22). A joint encoder's offset that varies with the angle (a disc
 # off centre) shows in no phase either; as a constant it left a set's held-out runs at 2.8 x the
-# background (2741 case 40: 1.1 x once per turn), and it costs no dead reckoning
+# background (2741 case 40: 1.1 x once per turn), and it costs no dead reckoning. A tyre that
+# grows with speed acts wherever the robot drives fast, turning or not, and the phases' "fast"
+# share proposes count loss; as a fixed Ed it was "ed + scrub" twice (2791 cases 32 and 50).
+# Unproposed it leads alone and joins no pair (`unproposed`)
 ALWAYS = ("eb", "skid@cornering", "rotary_bias@eccentric", "ed@growth")
 
 
