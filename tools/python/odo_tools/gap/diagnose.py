@@ -176,35 +176,7 @@ def _lever_on_arcs(ds: Dataset) -> None:
         keys = [k for k in keys if k != "es.value"] + ["es.value.A", "es.value.B"]
     best = _lever_rounds(ds, keys)
     if "skid" in catalog.hypotheses("truth", ds.robot.vehicle):
-        kc = "skid@cornering.deg_per_m_s2"
-        each = [f"{kc}.{t}" for t in "AB"] if ds.robot.n_trucks > 1 else [kc]
-
-        def deviance(r: _Levers) -> tuple[float, float, int]:
-            return Problem("truth", r.items, best.sigma).deviance(r.P)  # one noise scale
-
-        dev, chi, n = deviance(best)
-        c_hat = max(1.0, chi / n)  # the misfit the geometry leaves: overdispersion (Fit.qbic)
-        # a skid is looked for only where the geometry and the markers leave the tracks a gap
-        # (R >= R_GAP): without one, a skid on truck A took 0.9 % off the deviance by reading
-        # its marker 7 mm (2801 case 50, a set with no effect, then "skid") or 26 mm (dev 2701
-        # case 37, an Ed on the trailer, then "unexplained") behind the axle as on it; the
-        # skidding robots it is for leave 96-2000 x the noise's mean square without one (dev
-        # 2761 case 44, 2771 case 13, 2781 case 44)
-        if c_hat >= R_GAP * R_GAP:
-
-            def qbic(r: _Levers, dev: float, n: int) -> float:
-                return dev / c_hat + len(r.P) * math.log(max(n, 2))
-
-            # which trucks skid: each subset (a skid on one truck only took the other's marker,
-            # 25 mm behind its axle, for a skid: dev 2761 case 44); by quasi-BIC, as plain BIC
-            # took a skid on a set with slip, 21 below 36 000, and moved its marker 6 mm (2721
-            # case 45, tests/python/test_gap_slip_motor.py)
-            cost = qbic(best, dev, n)
-            for m in range(1, 1 << len(each)):
-                r = _lever_rounds(ds, keys + [k for i, k in enumerate(each) if m >> i & 1])
-                dev, _, n = deviance(r)
-                if (c := qbic(r, dev, n)) < cost:
-                    best, cost = r, c
+        best = _lever_with_skid(ds, keys, best)
     ds.instrument, ds.notes, ds.items = best.inst, best.notes, best.items
 
 
@@ -216,6 +188,43 @@ class _Levers(NamedTuple):
     items: list
     sigma: np.ndarray  # the noise scale of the last round's problem
     P: dict  # its fitted geometry
+
+
+def _lever_with_skid(ds: Dataset, keys: list[str], best: _Levers) -> _Levers:
+    """`_lever_on_arcs` read again with a cornering skid on each set of trucks in the
+    preliminary fit; the reading whose tracks (and linkage) fit best by quasi-BIC, `best` (found
+    without a skid) where none is better."""
+    kc = "skid@cornering.deg_per_m_s2"
+    each = [f"{kc}.{t}" for t in "AB"] if ds.robot.n_trucks > 1 else [kc]
+
+    def deviance(r: _Levers) -> tuple[float, float, int]:
+        return Problem("truth", r.items, best.sigma).deviance(r.P)  # one noise scale
+
+    dev, chi, n = deviance(best)
+    c_hat = max(1.0, chi / n)  # the misfit the geometry leaves: overdispersion (Fit.qbic)
+    # a skid is looked for only where the geometry and the markers leave the tracks a gap
+    # (R >= R_GAP): without one, a skid on truck A took 0.9 % off the deviance by reading its
+    # marker 7 mm (2801 case 50, a set with no effect, then "skid") or 26 mm (dev 2701 case 37,
+    # an Ed on the trailer, then "unexplained") behind the axle as on it; the skidding robots it
+    # is for leave 96-2000 x the noise's mean square without one (dev 2761 case 44, 2771 case
+    # 13, 2781 case 44)
+    if c_hat < R_GAP * R_GAP:
+        return best
+
+    def qbic(r: _Levers, dev: float, n: int) -> float:
+        return dev / c_hat + len(r.P) * math.log(max(n, 2))
+
+    # which trucks skid: each subset (a skid on one truck only took the other's marker, 25 mm
+    # behind its axle, for a skid: dev 2761 case 44); by quasi-BIC, as plain BIC took a skid on
+    # a set with slip, 21 below 36 000, and moved its marker 6 mm (2721 case 45,
+    # tests/python/test_gap_slip_motor.py)
+    cost = qbic(best, dev, n)
+    for m in range(1, 1 << len(each)):
+        r = _lever_rounds(ds, keys + [k for i, k in enumerate(each) if m >> i & 1])
+        dev, _, n = deviance(r)
+        if (c := qbic(r, dev, n)) < cost:
+            best, cost = r, c
+    return best
 
 
 def _lever_rounds(ds: Dataset, keys: list[str]) -> _Levers:
@@ -685,8 +694,10 @@ def _track_refit(ds: Dataset, sel: Selection, rk: Ranking, progress: Progress = 
     # the wheelbase's load law too: a clapper's Eb that grows under lateral load left its
     # tracks at 1.19 x as Eb + scrub (independent world, 2721 case 12), the way the windows'
     # ranking named a LabMate's before the law joined (2721 case 10)
-    singles += [h for h in hypotheses.other_laws("eb", "truth", ds.robot.vehicle) if "eb" in fams]
-    singles += [h for h in hypotheses.other_laws("ed", "truth", ds.robot.vehicle) if "ed" in fams]
+    # ... and Ed's growth law (one tyre that grows with speed: independent 2791 case 32)
+    for fam in ("eb", "ed"):
+        if fam in fams:
+            singles += hypotheses.other_laws(fam, "truth", ds.robot.vehicle)
     fits = []
     for h in singles:
         if progress:
