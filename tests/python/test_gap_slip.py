@@ -105,3 +105,19 @@ def test_slip_read_as_latency_is_told_apart_before_the_pairs(tmp_path: Path) -> 
     assert not any(m.startswith("fitting") and "+" in m for m in said[:told]), said[:told]
     assert said.count("latency and slip told apart: ranking again") == 1
     assert max(abs(v) for v in rep["instrument"]["latency_s"].values()) == 0.0
+
+
+def test_traction_slip_the_phases_do_not_propose_is_still_tried(tmp_path: Path) -> None:
+    """Independent world, seed 2791 case 51: a LabMate whose floor speed changes at most
+    0.84 m/s^2. It loses so much on every start that the track is off everywhere after the first,
+    the phases propose no family, and the catalog's slip alone left the held-out runs worse than
+    the nominal model ("unexplained", 19.9 -> 28.3 x the background). The traction laws are tried
+    on every robot (hypotheses.ALWAYS): slip under the traction law, near its true limit."""
+    from gap_support import indep_named
+
+    c, rep = indep_named(2791, 51, tmp_path, "labmate", {"slip": "traction"}, "slip", "traction")
+    assert rep["proposals"] == {}
+    a = rep["verdict"]["params"]["slip@traction.a_max_m_s2"]
+    assert a == pytest.approx(c["true"]["effects"]["slip"]["a_lim_m_s2"], rel=0.05)
+    h = rep["heldout"]
+    assert h["ratio_after"] < 0.25 * h["ratio_before"]
