@@ -62,17 +62,25 @@ def test_cornering_skid_below_the_catalog_threshold_is_named(tmp_path: Path) -> 
 
 def test_the_cornering_law_is_tried_unproposed_and_the_friction_circle_only_on_arcs() -> None:
     """hypotheses.tried_laws: without a proposal a ranking fits the load law, the cornering
-    skid and Ed's speed law beside the catalog's laws, not the friction circle (it limits
-    starts as well as turns); arcs that hold the misfit bring it; returns mode, which cannot
-    see a skid, gets none of them; a proposed family brings every one of its laws. An
-    unproposed law is no partner (hypotheses.unproposed)."""
+    skid, Ed's speed law and slip's traction laws beside the catalog's laws, not the friction
+    circle (it limits starts as well as turns); arcs that hold the misfit bring it; returns
+    mode, which cannot see a skid, gets no skid law; a proposed family brings every one of its
+    laws. An unproposed law is no partner (hypotheses.unproposed)."""
     from odo_tools.gap.hypotheses import tried_laws, unproposed
 
     def names(proposals: dict, mode: str = "truth", vehicle: str = "labmate") -> list[str]:
         return [h.name for h in tried_laws(proposals, mode, vehicle)]
 
-    assert names({}) == ["eb@load", "skid@cornering", "ed@growth"]
-    assert names({"skid": "arcs"}) == ["eb@load", "skid@cornering", "skid@friction", "ed@growth"]
+    traction = ["slip@traction", "slip@motor"]  # a floor short of the motor's torque: everywhere
+    assert names({}) == ["eb@load", "skid@cornering", "ed@growth", *traction]
+    assert names({"skid": "arcs"}) == [
+        "eb@load",
+        "skid@cornering",
+        "skid@friction",
+        "ed@growth",
+        *traction,
+    ]
+    assert names({}, "returns") == ["eb@load", "ed@growth", *traction]
     assert "skid@cornering" not in names({}, "returns")
     # unproposed, the cornering law may lead alone but joins no pair (2721 case 13: "ed+skid")
     laws = {h.name: h for h in tried_laws({}, "truth", "set")}
@@ -80,6 +88,8 @@ def test_the_cornering_law_is_tried_unproposed_and_the_friction_circle_only_on_a
     assert not unproposed(laws["skid@cornering"], {"skid": "arcs"})
     assert not unproposed(laws["eb@load"], {})
     assert unproposed(laws["ed@growth"], {})  # a tyre growing with speed leads alone, too
+    assert unproposed(laws["slip@motor"], {})  # and traction slip where no phase proposes slip
+    assert not unproposed(laws["slip@motor"], {"slip": "starts"})
     assert names({"slip": "starts"}, "returns") == [
         "eb@load",
         "ed@growth",
