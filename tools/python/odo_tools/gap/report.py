@@ -44,8 +44,7 @@ LAW_WORDS = {
     "motor": "traction saturation inside the tick: the motor takes each tick's speed with a lag "
     "tau, and the floor follows it by at most a_max",
     "speed": "a fraction of the counts lost above a wheel speed",
-    "growth": "one tyre's rolling radius grows with the square of its speed (centrifugal "
-    "growth): r (1 + |g| v^2), the left tyre for g > 0, the right for g < 0, beside a fixed Ed",
+    "growth": "one tyre's rolling radius grows with the square of its speed, beside a fixed Ed",
     "plateau": "a count-rate ceiling: the counts sit on a flat top while the hidden wheel speed "
     "rises beyond it and back",
     "cornering": "linear cornering stiffness: the tyres run at a slip angle proportional to the "
