@@ -55,120 +55,203 @@ NATURAL_SHARE = 0.8  # a step is fitted in the narrowest window that sees this s
 FLOOR_TOL_MM = 60.0  # events of one floor bump: their wheel's contact points this close ...
 SAME_WAY_RAD = math.radians(45.0)  # ... rolling the same way (within this)
 BUMP_SPAN_MM = 250.0  # a wheel's travel over one bump, ramps included
+WEAK_Z = 0.4  # a step this share of the detector's threshold is kept if other runs confirm it
 
 
 def detect_bumps(items: list, P: dict, sigma_head: float) -> list[dict]:
-    """Heading steps in each run's truth-minus-model heading; each refined to (wheel, s0, h)."""
-    events = []
+    """Heading steps in each run's truth-minus-model heading; each refined to (wheel, s0, h).
+    Steps the detector is sure of are fitted as they are found; weaker ones only once other runs
+    confirm them (confirm_weak: a fit per candidate made the detection a quarter slower)."""
+    events, weak = [], []
     for it in items:
-        pr = it.pr
         for truck in range(it.trucks):
-            mp = it.model_pose(P, truck)
-            e = it.tpose[:, truck, 2] - mp[:, 2]
-            tt = it.tt
-            dt = float(np.median(np.diff(tt)))
-            ms = [
-                m for m in sorted({max(3, round(w / dt)) for w in STEP_WIDTHS_S}) if e.size >= 4 * m
-            ]
-            if not ms:
-                continue
-            Ds = [_step_detector(e, m) for m in ms]
-            thrs = [
-                max(8.0 * _mad(D), 6.0 * sigma_head / math.sqrt(m), 2e-4)
-                for D, m in zip(Ds, ms, strict=True)
-            ]
-            masked = np.zeros(e.size, dtype=bool)
-            h_grid = np.linspace(0.2, 50.0, 400)
-            dd_grid = bump_dd(pr.R[truck], h_grid)
-            Sa = np.stack([np.interp(tt, pr.t, pr.S[:, truck, w]) for w in (0, 1)])
-            tick_all = np.clip(np.searchsorted(pr.t, tt - 1e-9), 0, pr.t.size - 1)
-            for _ in range(20):
-                # the strongest step at any width, in units of that width's threshold (wider
-                # windows average the truth's noise down), fitted in the window of its own width:
-                # the narrowest whose step is within 80 % of the widest's (a sharp step's is the
-                # same at every width, a ramp's grows until the window spans it). A sharp bump
-                # fitted in a ramp's 4 s window takes in the turns beside it (the simulator's
-                # 2742 bump cases went "unexplained")
-                z = [
-                    np.where(masked, 0.0, np.abs(D)) / thr for D, thr in zip(Ds, thrs, strict=True)
-                ]
-                j = int(np.argmax([zk.max() for zk in z]))
-                q = int(np.argmax(z[j]))
-                if z[j][q] < 1.0:
+            scan = _Scan(it, truck, P, sigma_head)
+            for _ in range(20 if scan.ms else 0):
+                step = scan.strongest()
+                if step is None:
                     break
-                a = np.array([abs(Dk[q]) for Dk in Ds])
-                j = int(np.flatnonzero(a >= NATURAL_SHARE * a.max())[0])
-                m, D = ms[j], Ds[j]
-                masked[max(0, q - 2 * m) : q + 2 * m] = True
-                kc = q
-                lo, hi = max(0, kc - 2 * m), min(e.size - 1, kc + 2 * m)
-                best = None
-                # a bump under the left wheel turns the truck left while that wheel rolls
-                # forward (_signed_excess): where both wheels roll one way the step's sign names
-                # the wheel, and its size the height (one start instead of two per wheel)
-                tick = int(np.clip(np.searchsorted(pr.t, tt[kc]), 1, pr.ds.shape[0])) - 1
-                roll = np.sign(pr.ds[tick, truck, :])
-                wheels = [w for w in (0, 1) if (1 if w == 0 else -1) * roll[w] == np.sign(D[q])]
-                if roll[0] != roll[1] or not wheels:
-                    wheels = [0, 1]
-                h0 = float(np.interp(abs(D[q]) * pr.b[truck], dd_grid, h_grid))
-                for w in wheels:
-                    s_lo, s_hi = Sa[w, lo], Sa[w, hi]
-                    if s_hi - s_lo < 20.0:
-                        continue
-                    idx = np.arange(lo, hi + 1)
-                    tick_idx = np.searchsorted(pr.t, tt[idx] - 1e-9)
-                    tick_idx = np.clip(tick_idx, 0, pr.t.size - 1)
-                    ta, tb = int(tick_idx[0]), int(tick_idx[-1]) + 1
-                    ti_loc = tick_idx - ta
-                    # offset and slope of the drift under the step enter linearly: projected
-                    # out (variable projection), the fit moves only height and position
-                    tau = tt[idx] - tt[kc]
-                    Q, _ = np.linalg.qr(np.column_stack([np.ones_like(tau), tau]))
-                    y0 = e[idx]
-
-                    def res(x, pr=pr, w=w, ti=ti_loc, truck=truck, ta=ta, tb=tb, Q=Q, y0=y0):
-                        y = y0 - _signed_excess(pr, truck, w, x[0], x[1], ta, tb)[ti]
-                        return (y - Q @ (Q.T @ y)) / 1e-4
-
-                    s_mid = Sa[w, kc]
-                    try:
-                        r = least_squares(
-                            res,
-                            [h0, s_mid - 30.0],
-                            bounds=([0.2, s_lo - 100], [50.0, s_hi]),
-                            max_nfev=80,
-                        )
-                    except ValueError:
-                        continue
-                    if best is None or r.cost < best[0]:
-                        best = (r.cost, w, r.x)
-                if best is None:
+                if step[3] < 1.0:
+                    rough = scan.rough(step)
+                    if rough is not None:
+                        weak.append((scan, step, rough))
                     continue
-                _, w, x = best
-                # take the event out of the residual before looking for the next: the detector
-                # answers a step with opposite side lobes of a third of it, and a big bump's ramp
-                # carries them past the mask (spurious "bumps" on the other wheel ~1.2 s later)
-                e = e - _signed_excess(pr, truck, w, x[0], x[1])[tick_all]
-                Ds = [_step_detector(e, mm) for mm in ms]
-                j = int(np.clip(np.searchsorted(Sa[w], x[1]), 0, tt.size - 1))
-                xy = _contact(it.tpose[j, truck], w, pr.b[truck])
-                events.append(
-                    {
-                        "run": pr.run.name,
-                        "session": pr.run.session,
-                        "group": group_key(pr),
-                        "truck": truck,
-                        "wheel": w,
-                        "s0": float(x[1]),
-                        "h": float(x[0]),
-                        "t_s": float(tt[j]),
-                        "x_mm": float(xy[0]),
-                        "y_mm": float(xy[1]),
-                        "dir_rad": _rolling(it, truck, w, j),
-                    }
-                )
+                ev = scan.fit(step)
+                if ev is not None:
+                    events.append(ev)
+    kept = confirm_weak(events + [r for _, _, r in weak])
+    for scan, step, rough in weak:
+        if any(k is rough for k in kept):
+            ev = scan.fit(step)
+            if ev is not None:
+                events.append(ev)
     return events
+
+
+class _Scan:
+    """The step detector over one truck of one truth run: the heading residual under P, its step
+    estimates at every width (STEP_WIDTHS_S) and thresholds, and the samples already taken."""
+
+    def __init__(self, it, truck: int, P: dict, sigma_head: float) -> None:
+        self.it, self.truck, self.pr, self.tt = it, truck, it.pr, it.tt
+        pr, tt = it.pr, it.tt
+        self.e = it.tpose[:, truck, 2] - it.model_pose(P, truck)[:, 2]
+        dt = float(np.median(np.diff(tt)))
+        widths = sorted({max(3, round(w / dt)) for w in STEP_WIDTHS_S})
+        self.ms = [m for m in widths if self.e.size >= 4 * m]
+        self.Ds = [_step_detector(self.e, m) for m in self.ms]
+        self.thrs = [
+            max(8.0 * _mad(D), 6.0 * sigma_head / math.sqrt(m), 2e-4)
+            for D, m in zip(self.Ds, self.ms, strict=True)
+        ]
+        self.masked = np.zeros(self.e.size, dtype=bool)
+        self.h_grid = np.linspace(0.2, 50.0, 400)
+        self.dd_grid = bump_dd(pr.R[truck], self.h_grid)
+        self.Sa = np.stack([np.interp(tt, pr.t, pr.S[:, truck, w]) for w in (0, 1)])
+        self.tick_all = np.clip(np.searchsorted(pr.t, tt - 1e-9), 0, pr.t.size - 1)
+
+    def strongest(self) -> tuple | None:
+        """The strongest step not yet taken at any width, in units of that width's threshold
+        (wider windows average the truth's noise down), as (sample, window, D, z), taken from
+        the scan (masked); None below WEAK_Z. Its window is the narrowest whose step is within
+        80 % of the widest's (a sharp step's is the same at every width, a ramp's grows until the
+        window spans it): a sharp bump fitted in a ramp's 4 s window takes in the turns beside
+        it (the simulator's 2742 bump cases went "unexplained")."""
+        z = [
+            np.where(self.masked, 0.0, np.abs(D)) / thr
+            for D, thr in zip(self.Ds, self.thrs, strict=True)
+        ]
+        j = int(np.argmax([zk.max() for zk in z]))
+        q = int(np.argmax(z[j]))
+        zq = float(z[j][q])
+        if zq < WEAK_Z:
+            return None
+        a = np.array([abs(Dk[q]) for Dk in self.Ds])
+        j = int(np.flatnonzero(a >= NATURAL_SHARE * a.max())[0])
+        m = self.ms[j]
+        self.masked[max(0, q - 2 * m) : q + 2 * m] = True
+        return q, m, self.Ds[j], zq
+
+    def _wheels(self, q: int, D: np.ndarray) -> list[int]:
+        """A bump under the left wheel turns the truck left while that wheel rolls forward
+        (_signed_excess): where both wheels roll one way the step's sign names the wheel."""
+        pr = self.pr
+        tick = int(np.clip(np.searchsorted(pr.t, self.tt[q]), 1, pr.ds.shape[0])) - 1
+        roll = np.sign(pr.ds[tick, self.truck, :])
+        wheels = [w for w in (0, 1) if (1 if w == 0 else -1) * roll[w] == np.sign(D[q])]
+        return wheels if roll[0] == roll[1] and wheels else [0, 1]
+
+    def _event(self, w: int, s0: float, h: float, z: float) -> dict:
+        pr, t = self.pr, self.truck
+        j = int(np.clip(np.searchsorted(self.Sa[w], s0), 0, self.tt.size - 1))
+        xy = _contact(self.it.tpose[j, t], w, pr.b[t])
+        return {
+            "run": pr.run.name,
+            "session": pr.run.session,
+            "group": group_key(pr),
+            "truck": t,
+            "wheel": w,
+            "s0": float(s0),
+            "h": float(h),
+            "t_s": float(self.tt[j]),
+            "x_mm": float(xy[0]),
+            "y_mm": float(xy[1]),
+            "dir_rad": _rolling(self.it, t, w, j),
+            "z": z,
+            "edge": min(abs(s0 - pr.S[0, t, w]), abs(pr.S[-1, t, w] - s0)) < BUMP_SPAN_MM,
+        }
+
+    def rough(self, step: tuple) -> dict | None:
+        """A weak step's event where the detector found it, unfitted (for confirm_weak); None
+        where its sign does not name one wheel (a spot turn)."""
+        q, _, D, zq = step
+        wheels = self._wheels(q, D)
+        if len(wheels) != 1:
+            return None
+        return self._event(wheels[0], float(self.Sa[wheels[0], q]), 0.0, zq)
+
+    def fit(self, step: tuple) -> dict | None:
+        """The step fitted with the rigid-wheel profile (wheel, s0, h) and taken out of the
+        residual: the detector answers a step with opposite side lobes of a third of it, and a
+        big bump's ramp carries them past the mask (spurious "bumps" on the other wheel ~1.2 s
+        later). None where no wheel rolls far enough in the step's window."""
+        pr, tt, truck, e, Sa = self.pr, self.tt, self.truck, self.e, self.Sa
+        kc, m, D, zq = step
+        lo, hi = max(0, kc - 2 * m), min(e.size - 1, kc + 2 * m)
+        h0 = float(np.interp(abs(D[kc]) * pr.b[truck], self.dd_grid, self.h_grid))
+        best = None
+        for w in self._wheels(kc, D):
+            s_lo, s_hi = Sa[w, lo], Sa[w, hi]
+            if s_hi - s_lo < 20.0:
+                continue
+            idx = np.arange(lo, hi + 1)
+            tick_idx = np.clip(np.searchsorted(pr.t, tt[idx] - 1e-9), 0, pr.t.size - 1)
+            ta, tb = int(tick_idx[0]), int(tick_idx[-1]) + 1
+            ti_loc = tick_idx - ta
+            # offset and slope of the drift under the step enter linearly: projected out
+            # (variable projection), the fit moves only height and position
+            tau = tt[idx] - tt[kc]
+            Q, _ = np.linalg.qr(np.column_stack([np.ones_like(tau), tau]))
+            y0 = e[idx]
+
+            def res(x, w=w, ti=ti_loc, ta=ta, tb=tb, Q=Q, y0=y0):
+                y = y0 - _signed_excess(pr, truck, w, x[0], x[1], ta, tb)[ti]
+                return (y - Q @ (Q.T @ y)) / 1e-4
+
+            try:
+                r = least_squares(
+                    res,
+                    [h0, Sa[w, kc] - 30.0],
+                    bounds=([0.2, s_lo - 100], [50.0, s_hi]),
+                    max_nfev=80,
+                )
+            except ValueError:
+                continue
+            if best is None or r.cost < best[0]:
+                best = (r.cost, w, r.x)
+        if best is None:
+            return None
+        _, w, x = best
+        self.e = e - _signed_excess(pr, truck, w, x[0], x[1])[self.tick_all]
+        self.Ds = [_step_detector(self.e, mm) for mm in self.ms]
+        return self._event(w, float(x[1]), float(x[0]), zq)
+
+
+def _near(e: dict, o: dict) -> bool:
+    """Two events at one spot of the floor: their contact points within FLOOR_TOL_MM across the
+    way the wheel rolls and half a bump's span along it (where on a step's profile a noisy
+    step is placed moves along the track: 2741 case 4's cleat, 62 mm apart in two runs)."""
+    dx, dy = o["x_mm"] - e["x_mm"], o["y_mm"] - e["y_mm"]
+    c, s = math.cos(e["dir_rad"]), math.sin(e["dir_rad"])
+    return abs(dx * c + dy * s) < 0.5 * BUMP_SPAN_MM and abs(dy * c - dx * s) < FLOOR_TOL_MM
+
+
+def confirm_weak(events: list[dict]) -> list[dict]:
+    """The events the detector is sure of (z >= 1), and the weaker ones (WEAK_Z <= z < 1) that
+    other runs saw at the same spot of the floor: the runs' steps there, each a noisy estimate of
+    one bump's, stacked (sum of z / sqrt(runs) >= 1). A 0.4 deg step of a 2.4 mm cable under a
+    0.3 deg truth noise reaches z 0.5 in each of four runs and nothing otherwise (independent
+    world 2741 case 4, 2771 case 16: "unexplained", the cable that every square crosses missing
+    from every model). Weak steps in a wheel's first or last BUMP_SPAN_MM are the start's and
+    stop's transients, met by every run at one spot, and are not taken."""
+    strong = [e for e in events if e["z"] >= 1.0]
+    weak = [e for e in events if e["z"] < 1.0 and not e["edge"]]
+    pool = strong + weak
+    out = list(strong)
+    for e in weak:
+        near = [
+            o
+            for o in pool
+            if o["truck"] == e["truck"]
+            and o.get("session") == e.get("session")
+            and _same_way(o["dir_rad"], e["dir_rad"])
+            and _near(e, o)
+        ]
+        best: dict[str, float] = {}
+        for o in near:  # one estimate per run: its strongest there
+            best[o["run"]] = max(best.get(o["run"], 0.0), min(o["z"], 1.0))
+        if len(best) >= 2 and sum(best.values()) / math.sqrt(len(best)) >= 1.0:
+            out.append(e)
+    return out
 
 
 def _contact(pose: np.ndarray, wheel: int, b: float) -> tuple:
