@@ -162,6 +162,33 @@ def test_verdict_reads_the_held_out_misfit_against_the_background(r0, r1, dbic, 
 
 
 @pytest.mark.parametrize(
+    ("r0", "r1", "dbic", "weak", "dof", "expect"),
+    [
+        (1.97, 0.93, 1670.0, True, None, "ed"),  # dev 2801 case 22: both sides agree
+        (1.97, 0.93, 1670.0, False, None, "no significant gap"),  # returns, linkage: not asked
+        (1.97, 0.93, 60.0, True, None, "no significant gap"),  # the fitting runs barely want it
+        (1.8, 1.45, 500.0, True, None, "no significant gap"),  # removes 52 %: not closed
+        (1.45, 1.0, 500.0, True, None, "no significant gap"),  # below 1.5 x: background
+        (1.9, 1.0, 500.0, True, 3.0, "no significant gap"),  # a few runs' spread: F's gap rules
+    ],
+)
+def test_a_gap_below_twice_the_background_is_named_where_both_sides_agree(
+    r0, r1, dbic, weak, dof, expect
+) -> None:
+    """Truth mode names a gap of 1.5-2 x the background when the fitting runs want the candidate
+    by Delta BIC >= 100 and it removes >= 75 % of the held-out excess; never "unexplained"."""
+    from odo_tools.gap.heldout import HeldOut, RunGap
+    from odo_tools.gap.verdict import decide
+
+    runs = [RunGap("a", 0, 0, 0, 3), RunGap("b", 0, 0, 0, 3)]
+    h = HeldOut([], runs, runs, [], [], ratio_before=r0, ratio_after=r1)
+    if dof is not None:
+        h.extra["noise_dof"] = dof
+    verdict, reason = decide(h, dbic, "ed", weak_gap=weak)
+    assert verdict == expect, reason
+
+
+@pytest.mark.parametrize(
     ("r0", "r1", "dof", "expect"),
     [
         (4.0, 1.0, 3.0, "no significant gap"),  # 6 values against a 3-dof spread: F's 99 % is 28

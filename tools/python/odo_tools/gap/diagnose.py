@@ -1028,7 +1028,7 @@ def judge(ds: Dataset, sel: Selection, rk: Ranking) -> Judgement:
     if ds.noise_dof is not None:
         held.extra["noise_dof"] = ds.noise_dof
     dbic = rk.null.bic - rk.best.bic
-    verdict, reason = decide(held, dbic, rk.best.label)
+    verdict, reason = decide(held, dbic, rk.best.label, weak_gap=ds.mode == "truth")
     return Judgement(verdict, reason, bg, held, dbic)
 
 

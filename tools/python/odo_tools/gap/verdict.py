@@ -6,13 +6,19 @@ from __future__ import annotations
 
 import math
 
-from .fit import DBIC_SIGNIFICANT
 from .heldout import HeldOut
 
 # the verdict, on the held-out runs (heldout.py: R = RMS misfit in units of the background)
 R_GAP = 2.0  # nominal misfit at least twice the background: a gap
-R_GAP_WITH_BIC = R_GAP  # the fitting runs' Delta BIC alone never makes a gap: with thousands of
-# windows it finds something in every real recording (the independent world's no-effect clapper)
+# The fitting runs' Delta BIC alone never makes a gap: with thousands of windows it finds something
+# in every real recording (the independent world's no-effect clapper). Truth mode names a smaller
+# gap, R_GAP_WEAK <= R < R_GAP, where both sides agree: the fitting runs want the candidate by
+# DBIC_WEAK_GAP and it removes EXCESS_REMOVED of the held-out misfit above the background (dev
+# seed 2801 case 22, a traction slip: R 1.97 -> 0.93 at Delta BIC 1670, "no significant gap";
+# the 54 robots with no effect of dev seeds 2701-2801 reach R 1.5-2 five times, none with a
+# candidate above Delta BIC 10 that closes it)
+R_GAP_WEAK = 1.5
+DBIC_WEAK_GAP = 100.0
 R_WITHIN = 1.5  # after the fit, within 1.5 x the background: the effect is named
 EXCESS_REMOVED = 0.75  # ... or it removes this share of the held-out misfit above background
 
@@ -42,23 +48,41 @@ def r_gap(held: HeldOut) -> float:
     return max(R_GAP, math.sqrt(float(fdist.ppf(GAP_QUANTILE, n, dof))))
 
 
-def decide(held: HeldOut, dbic: float, label: str) -> tuple[str, str]:
-    """The verdict from the held-out misfit ratios R (heldout.py) in words."""
+def decide(held: HeldOut, dbic: float, label: str, weak_gap: bool = False) -> tuple[str, str]:
+    """The verdict from the held-out misfit ratios R (heldout.py) in words; `weak_gap` (truth
+    mode): a gap from R_GAP_WEAK where the fitting runs and the held-out runs agree."""
     r0, r1 = held.ratio_before, held.ratio_after
     excess0, excess1 = r0 * r0 - 1.0, r1 * r1 - 1.0
     removed = 1.0 - excess1 / excess0 if excess0 > 0 else 0.0
     rg = r_gap(held)
-    if not (r0 >= rg or (dbic >= DBIC_SIGNIFICANT and r0 >= max(R_GAP_WITH_BIC, rg))):
+    if (
+        weak_gap
+        and R_GAP_WEAK <= r0 < rg == R_GAP
+        and dbic >= DBIC_WEAK_GAP
+        and removed >= EXCESS_REMOVED
+    ):
+        return label, (
+            f"{label} brings the held-out misfit from {r0:.2f} to {r1:.2f} x the background, "
+            f"removing {removed:.0%} of the misfit above it, and the fitting runs want it by "
+            f"Delta BIC {dbic:.0f} (a gap below {R_GAP:g} x is named from {R_GAP_WEAK:g} x "
+            f"where it removes >= {EXCESS_REMOVED:.0%} at Delta BIC >= {DBIC_WEAK_GAP:g})"
+        )
+    if r0 < rg:
         if rg > R_GAP:
             return "no significant gap", (
                 f"the nominal model's held-out misfit is {r0:.2f} x the background, which is "
                 f"itself the spread of few runs ({held.extra['noise_dof']:g} degrees of freedom):"
                 f" a gap needs {rg:.2f} x (the {GAP_QUANTILE:.0%} point of F)"
             )
+        weak = (
+            f", or {R_GAP_WEAK:g} x closed by a candidate the fitting runs want by Delta BIC >= "
+            f"{DBIC_WEAK_GAP:g}; the best, {label}, leaves {r1:.2f} x at Delta BIC {dbic:.1f}"
+            if weak_gap
+            else ""
+        )
         return "no significant gap", (
             f"the nominal model's held-out misfit is {r0:.2f} x the background (a gap needs "
-            f"{R_GAP:g} x, or {R_GAP_WITH_BIC:g} x with Delta BIC >= {DBIC_SIGNIFICANT:g} on the "
-            f"fitting runs; it is {dbic:.1f})"
+            f"{R_GAP:g} x{weak})"
         )
     if r1 <= R_WITHIN or removed >= EXCESS_REMOVED:
         return label, (
@@ -75,7 +99,8 @@ def decide(held: HeldOut, dbic: float, label: str) -> tuple[str, str]:
 
 THRESHOLDS = {
     "heldout_ratio_gap": R_GAP,
-    "heldout_ratio_gap_with_bic": R_GAP_WITH_BIC,
+    "heldout_ratio_weak_gap_truth": R_GAP_WEAK,
+    "dbic_weak_gap_truth": DBIC_WEAK_GAP,
     "heldout_ratio_named": R_WITHIN,
     "heldout_excess_removed_named": EXCESS_REMOVED,
     "heldout_gap_quantile_few_dof": GAP_QUANTILE,
