@@ -134,6 +134,19 @@ def test_blind_bad_option_value_is_one_line_exit_1(tmp_path: Path, extra, expect
     assert not out.exists() and not list(tmp_path.iterdir())
 
 
+def test_a_refused_report_folder_is_refused_before_any_fit(good: Path, tmp_path: Path) -> None:
+    """A user's folder or the input itself as OUT: one line, exit 1, before any fitting (the
+    refusal used to come after the whole diagnosis, its progress printed first)."""
+    out = tmp_path / "mine"
+    out.mkdir()
+    (out / "notes.txt").write_text("mine")
+    for target in (out, good):
+        r = odo_gap("diagnose", "--real", str(good), "--robot", LABMATE, "--out", str(target))
+        assert r.returncode == 1 and r.stderr.count("\n") == 1, r.stderr
+        assert "fitting" not in r.stderr
+    assert sorted(p.name for p in out.iterdir()) == ["notes.txt"]
+
+
 def test_report_folder_rule(good: Path, tmp_path: Path) -> None:
     """The output rule (odo_tools/outpath.py): a user's folder is refused and kept; an empty one
     is filled; a previous report is replaced file by file (its manifest), and the user's own

@@ -20,7 +20,15 @@ from hypothesis import strategies as st
 from odo_tools import importer
 from odo_tools.gap import io as gap_io
 from odo_tools.gap.errors import GapInputError
-from odo_tools.outpath import MANIFEST, Inputs, OutDir, OutputError, out_file, read_manifest
+from odo_tools.outpath import (
+    MANIFEST,
+    Inputs,
+    OutDir,
+    OutputError,
+    check_dir,
+    out_file,
+    read_manifest,
+)
 
 BUILD = Path(os.environ["ODO_BUILD_DIR"])
 SRC = Path(os.environ["ODO_SOURCE_DIR"])
@@ -396,3 +404,21 @@ def test_plot_umbmark_creates_missing_parents(tmp_path: Path) -> None:
     )  # fmt: skip
     assert r.returncode == 0, r.stderr
     assert (tmp_path / "a/b/u.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_check_dir_refuses_what_outdir_refuses_and_creates_nothing(tmp_path: Path) -> None:
+    mine = tmp_path / "mine"
+    mine.mkdir()
+    (mine / "notes.txt").write_text("x")
+    src = tmp_path / "src"
+    src.mkdir()
+    (tmp_path / "file").write_text("x")
+    for target, inputs in ((mine, None), (src / "out", [src]), (tmp_path / "file", None)):
+        with pytest.raises(OutputError):
+            check_dir(target, "odo-x", inputs=inputs)
+        with pytest.raises(OutputError):
+            OutDir(target, "odo-x", inputs=inputs)
+    check_dir(mine, "odo-x", force=True)  # --force may write there
+    check_dir(tmp_path / "new" / "deeper", "odo-x")  # a fresh target: allowed, not made
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["file", "mine", "src"]
+    assert [p.name for p in mine.iterdir()] == ["notes.txt"] and not any(src.iterdir())

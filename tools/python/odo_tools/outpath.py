@@ -291,6 +291,44 @@ def _manifest_text(tool: str, names: Iterable[str]) -> str:
     return "".join(f"{line}\n" for line in [MAGIC, f"tool {tool}", *names])
 
 
+def _target(path: Path, tool: str, force: bool, inputs: Inputs) -> tuple[str, list[str]]:
+    """How `tool` may write the folder `path` ("fresh", "update" with the old manifest's names,
+    or "force"), or OutputError where the rule forbids it."""
+    if path.name in ("", ".", ".."):
+        raise OutputError(path, "is not a folder name")
+    inputs.check(path)
+    try:
+        st = os.lstat(path)
+    except (FileNotFoundError, NotADirectoryError):
+        return "fresh", []
+    if not stat.S_ISDIR(st.st_mode):
+        raise OutputError(path, f"is {_kind(st.st_mode)}, not a folder; refusing to replace it")
+    if not any(os.scandir(path)):
+        return "fresh", []
+    if (old := read_manifest(path, tool)) is not None:
+        return "update", old
+    if force:
+        return "force", []
+    raise OutputError(
+        path,
+        f"is a non-empty folder {tool} did not write (no {MANIFEST} of its own in it); "
+        "refusing to write there (--force writes into it, replacing same-named files and "
+        "removing nothing)",
+    )
+
+
+def check_dir(
+    path: str | Path,
+    tool: str,
+    force: bool = False,
+    inputs: Inputs | Iterable[str | Path | None] | None = None,
+) -> None:
+    """OutputError now where OutDir(path, tool, force, inputs) would refuse later: a tool that
+    works for a while before it writes checks first, so a user is not kept waiting for a
+    refusal. Nothing is created (OutDir checks again: the folder may change meanwhile)."""
+    _target(Path(path), tool, force, _as_inputs(inputs))
+
+
 class OutDir:
     """Build an output folder by the rule. Write into `self.tmp` (a fresh folder beside the
     target: open files there or hand it to a writer); every file under it at the end is the
@@ -308,33 +346,7 @@ class OutDir:
         self.path = Path(path)
         self.tool = tool
         self.inputs = _as_inputs(inputs)
-        if self.path.name in ("", ".", ".."):
-            raise OutputError(self.path, "is not a folder name")
-        self.inputs.check(self.path)
-        self.old: list[str] = []
-        try:
-            st = os.lstat(self.path)
-        except (FileNotFoundError, NotADirectoryError):
-            st = None
-        if st is None:
-            self.mode = "fresh"
-        elif not stat.S_ISDIR(st.st_mode):
-            raise OutputError(
-                self.path, f"is {_kind(st.st_mode)}, not a folder; refusing to replace it"
-            )
-        elif not any(os.scandir(self.path)):
-            self.mode = "fresh"
-        elif (old := read_manifest(self.path, tool)) is not None:
-            self.mode, self.old = "update", old
-        elif force:
-            self.mode = "force"
-        else:
-            raise OutputError(
-                self.path,
-                f"is a non-empty folder {tool} did not write (no {MANIFEST} of its own in it); "
-                "refusing to write there (--force writes into it, replacing same-named files and "
-                "removing nothing)",
-            )
+        self.mode, self.old = _target(self.path, tool, force, self.inputs)
         self._made = _make_parents(self.path.parent)
         for _ in range(100):
             tmp = self.path.parent / f".{self.path.name}.tmp-{os.getpid()}-{secrets.token_hex(3)}"

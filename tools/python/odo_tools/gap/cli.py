@@ -139,8 +139,9 @@ def main(argv: list[str] | None = None) -> int:
                 if len(acc) != 2 or not all(math.isfinite(x) and x > 0 for x in acc):
                     raise _Usage("--return-accuracy: expected MM,DEG, two positive numbers")
             from .diagnose import diagnose
-            from .report import write_report
+            from .report import check_out, write_report
 
+            check_out(a.out, a.force, [*a.real, a.robot])  # refused before the work, not after
             t0 = time.perf_counter()
             rep = diagnose(
                 a.real,

@@ -612,6 +612,17 @@ def _remainder(rep: dict) -> str:
     return "; ".join(parts)
 
 
+def check_out(out: str | Path, force: bool = False, inputs: list | None = None) -> None:
+    """GapInputError now where write_report(..., out, force, inputs) would refuse OUT."""
+    from ..outpath import OutputError, check_dir
+    from .errors import GapInputError
+
+    try:
+        check_dir(out, "odo-gap", force, inputs)
+    except OutputError as e:
+        raise GapInputError(e.path, e.why) from None
+
+
 def write_report(
     rep: Report, out: str | Path, force: bool = False, inputs: list | None = None
 ) -> None:
