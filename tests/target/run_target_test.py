@@ -217,6 +217,12 @@ def run_selftest(args: argparse.Namespace) -> int:
                 vals = struct.unpack(SELFTEST_FMT, qmp.read_mem(addr, size))
                 got = dict(zip(SELFTEST_KEYS, vals, strict=True))
                 if got["done"] == codes["selftest_done"]:
+                    # the read is not atomic against the running CPU: one that races the
+                    # image's copy of the struct saw `done` with the fields before it still zero
+                    # (steps=0, frames=0 once in a CI run); the image never writes it again
+                    time.sleep(0.1)
+                    vals = struct.unpack(SELFTEST_FMT, qmp.read_mem(addr, size))
+                    got = dict(zip(SELFTEST_KEYS, vals, strict=True))
                     break
                 if time.monotonic() > deadline:
                     return fail(f"the image did not finish its self-test in {args.timeout} s "
@@ -231,6 +237,8 @@ def run_selftest(args: argparse.Namespace) -> int:
                 while True:
                     board = struct.unpack(BOARD_FMT, qmp.read_mem(baddr, bsize))
                     if board[7] == 1 or time.monotonic() > deadline:  # tick_ok: start-up done
+                        time.sleep(0.1)  # as above: read again, not racing the first copy
+                        board = struct.unpack(BOARD_FMT, qmp.read_mem(baddr, bsize))
                         break
                     time.sleep(0.1)
         finally:
