@@ -5,6 +5,7 @@ of runs of one path at one wheel travel into floor bumps."""
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 from scipy.optimize import least_squares
@@ -55,7 +56,15 @@ NATURAL_SHARE = 0.8  # a step is fitted in the narrowest window that sees this s
 FLOOR_TOL_MM = 60.0  # events of one floor bump: their wheel's contact points this close ...
 SAME_WAY_RAD = math.radians(45.0)  # ... rolling the same way (within this)
 BUMP_SPAN_MM = 250.0  # a wheel's travel over one bump, ramps included
+SURE_Z = 1.0  # a step this many thresholds strong is a bump event on its own
 WEAK_Z = 0.4  # a step this share of the detector's threshold is kept if other runs confirm it
+
+
+class _Step(NamedTuple):
+    q: int  # the truth sample at its middle
+    m: int  # the samples either side of it in its window
+    D: np.ndarray  # that window's step estimates
+    z: float  # its size in units of that window's threshold
 
 
 def detect_bumps(items: list, P: dict, sigma_head: float) -> list[dict]:
@@ -70,7 +79,7 @@ def detect_bumps(items: list, P: dict, sigma_head: float) -> list[dict]:
                 step = scan.strongest()
                 if step is None:
                     break
-                if step[3] < 1.0:
+                if step.z < SURE_Z:
                     rough = scan.rough(step)
                     if rough is not None:
                         weak.append((scan, step, rough))
@@ -78,9 +87,9 @@ def detect_bumps(items: list, P: dict, sigma_head: float) -> list[dict]:
                 ev = scan.fit(step)
                 if ev is not None:
                     events.append(ev)
-    kept = confirm_weak(events + [r for _, _, r in weak])
+    kept = {id(k) for k in confirm_weak(events + [r for _, _, r in weak])}
     for scan, step, rough in weak:
-        if any(k is rough for k in kept):
+        if id(rough) in kept:
             ev = scan.fit(step)
             if ev is not None:
                 events.append(ev)
@@ -109,10 +118,10 @@ class _Scan:
         self.Sa = np.stack([np.interp(tt, pr.t, pr.S[:, truck, w]) for w in (0, 1)])
         self.tick_all = np.clip(np.searchsorted(pr.t, tt - 1e-9), 0, pr.t.size - 1)
 
-    def strongest(self) -> tuple | None:
+    def strongest(self) -> _Step | None:
         """The strongest step not yet taken at any width, in units of that width's threshold
-        (wider windows average the truth's noise down), as (sample, window, D, z), taken from
-        the scan (masked); None below WEAK_Z. Its window is the narrowest whose step is within
+        (wider windows average the truth's noise down), taken from the scan (masked); None
+        below WEAK_Z. Its window is the narrowest whose step is within
         80 % of the widest's (a sharp step's is the same at every width, a ramp's grows until the
         window spans it): a sharp bump fitted in a ramp's 4 s window takes in the turns beside
         it (the simulator's 2742 bump cases went "unexplained")."""
@@ -129,7 +138,7 @@ class _Scan:
         j = int(np.flatnonzero(a >= NATURAL_SHARE * a.max())[0])
         m = self.ms[j]
         self.masked[max(0, q - 2 * m) : q + 2 * m] = True
-        return q, m, self.Ds[j], zq
+        return _Step(q, m, self.Ds[j], zq)
 
     def _wheels(self, q: int, D: np.ndarray) -> list[int]:
         """A bump under the left wheel turns the truck left while that wheel rolls forward
@@ -160,7 +169,7 @@ class _Scan:
             "edge": min(abs(s0 - pr.S[0, t, w]), abs(pr.S[-1, t, w] - s0)) < BUMP_SPAN_MM,
         }
 
-    def rough(self, step: tuple) -> dict | None:
+    def rough(self, step: _Step) -> dict | None:
         """A weak step's event where the detector found it, unfitted (for confirm_weak); None
         where its sign does not name one wheel (a spot turn)."""
         q, _, D, zq = step
@@ -169,7 +178,7 @@ class _Scan:
             return None
         return self._event(wheels[0], float(self.Sa[wheels[0], q]), 0.0, zq)
 
-    def fit(self, step: tuple) -> dict | None:
+    def fit(self, step: _Step) -> dict | None:
         """The step fitted with the rigid-wheel profile (wheel, s0, h) and taken out of the
         residual: the detector answers a step with opposite side lobes of a third of it, and a
         big bump's ramp carries them past the mask (spurious "bumps" on the other wheel ~1.2 s
@@ -226,15 +235,15 @@ def _near(e: dict, o: dict) -> bool:
 
 
 def confirm_weak(events: list[dict]) -> list[dict]:
-    """The events the detector is sure of (z >= 1), and the weaker ones (WEAK_Z <= z < 1) that
+    """The events the detector is sure of (z >= SURE_Z), and the weaker ones (WEAK_Z <= z) that
     other runs saw at the same spot of the floor: the runs' steps there, each a noisy estimate of
     one bump's, stacked (sum of z / sqrt(runs) >= 1). A 0.4 deg step of a 2.4 mm cable under a
     0.3 deg truth noise reaches z 0.5 in each of four runs and nothing otherwise (independent
     world 2741 case 4, 2771 case 16: "unexplained", the cable that every square crosses missing
     from every model). Weak steps in a wheel's first or last BUMP_SPAN_MM are the start's and
     stop's transients, met by every run at one spot, and are not taken."""
-    strong = [e for e in events if e["z"] >= 1.0]
-    weak = [e for e in events if e["z"] < 1.0 and not e["edge"]]
+    strong = [e for e in events if e["z"] >= SURE_Z]
+    weak = [e for e in events if e["z"] < SURE_Z and not e["edge"]]
     pool = strong + weak
     out = list(strong)
     for e in weak:
@@ -248,8 +257,8 @@ def confirm_weak(events: list[dict]) -> list[dict]:
         ]
         best: dict[str, float] = {}
         for o in near:  # one estimate per run: its strongest there
-            best[o["run"]] = max(best.get(o["run"], 0.0), min(o["z"], 1.0))
-        if len(best) >= 2 and sum(best.values()) / math.sqrt(len(best)) >= 1.0:
+            best[o["run"]] = max(best.get(o["run"], 0.0), min(o["z"], SURE_Z))
+        if len(best) >= 2 and sum(best.values()) / math.sqrt(len(best)) >= SURE_Z:
             out.append(e)
     return out
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import math
+from contextlib import contextmanager
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -612,15 +613,27 @@ def _remainder(rep: dict) -> str:
     return "; ".join(parts)
 
 
-def check_out(out: str | Path, force: bool = False, inputs: list | None = None) -> None:
-    """GapInputError now where write_report(..., out, force, inputs) would refuse OUT."""
-    from ..outpath import OutputError, check_dir
+TOOL = "odo-gap"  # the report folder's manifest owner
+
+
+@contextmanager
+def _refusals_as_input_errors():
+    """The output rule's refusals (OutputError) as odo-gap's one-line input errors."""
+    from ..outpath import OutputError
     from .errors import GapInputError
 
     try:
-        check_dir(out, "odo-gap", force, inputs)
+        yield
     except OutputError as e:
         raise GapInputError(e.path, e.why) from None
+
+
+def check_out(out: str | Path, force: bool = False, inputs: list | None = None) -> None:
+    """GapInputError now where write_report(..., out, force, inputs) would refuse OUT."""
+    from ..outpath import check_dir
+
+    with _refusals_as_input_errors():
+        check_dir(out, TOOL, force, inputs)
 
 
 def write_report(
@@ -631,21 +644,15 @@ def write_report(
     into only when it holds odo-gap's manifest (then exactly the files that manifest lists are
     replaced or removed, the user's other files stay) or with `force` (same-named files
     replaced, nothing removed); an OUT that is or lies in an input is refused."""
-    from ..outpath import OutDir, OutputError
-    from .errors import GapInputError
+    from ..outpath import OutDir
     from .plots import plot_report
 
-    try:
-        with OutDir(out, "odo-gap", force, inputs) as od:
-            d = rep.to_dict()
-            (od.tmp / "report.json").write_text(
-                json.dumps(d, indent=2, default=_json_default) + "\n"
-            )
-            (od.tmp / "report.md").write_text(markdown(d))
-            if rep.context is not None:
-                plot_report(d, rep.context, od.tmp)
-    except OutputError as e:
-        raise GapInputError(e.path, e.why) from None
+    with _refusals_as_input_errors(), OutDir(out, TOOL, force, inputs) as od:
+        d = rep.to_dict()
+        (od.tmp / "report.json").write_text(json.dumps(d, indent=2, default=_json_default) + "\n")
+        (od.tmp / "report.md").write_text(markdown(d))
+        if rep.context is not None:
+            plot_report(d, rep.context, od.tmp)
 
 
 def _json_default(o):
