@@ -224,6 +224,15 @@ def test_count_loss_at_a_rate_ceiling_recovers_the_hidden_speed() -> None:
 
     pr, slow = prep(counted), prep(0.5 * counted)
     assert plateau_level([pr, slow]) == pytest.approx(ceil, rel=1e-9)
+    # ticks above the flat top, each at its own speed (a truck's frame late by a tick, the
+    # next one doubled): the ceiling is still where the counts sit, not the fastest tick
+    spiky = counted.copy()
+    spiky[[5, 40, 90]] = ceil * dt * np.array([2.0, 1.3, 1.7])
+    assert plateau_level([prep(spiky)]) == pytest.approx(ceil, rel=1e-9)
+    # ... and a decoder that never saturated reads its top cruise, not a spike above it
+    cruise = 0.5 * counted
+    cruise[[7]] = 0.9 * ceil * dt
+    assert plateau_level([prep(cruise)]) == pytest.approx(0.5 * ceil, rel=1e-9)
     P = {
         "count_loss@plateau.level_mm_s": ceil,
         "count_loss@plateau.excess_mm_s": vmax - ceil,
