@@ -147,6 +147,24 @@ def test_a_trailer_truck_s_own_es_is_tried_when_the_misfit_leans_to_it(tmp_path:
     assert abs(v["params"]["es.value.B"] - es) < 0.15 * abs(es - 1.0), (v["params"], es)
 
 
+def test_both_trucks_own_geometry_is_tried_whichever_the_windows_lean_to(tmp_path: Path) -> None:
+    """The independent world's seed 2841 case 58 (traced after that seed was measured): a
+    clapper whose truck B alone has an Ed of 0.99879. B's tracks were 27-113 mm off and A's
+    within 2 mm, but the windows' excess leaned to truck A, whose own variants were the only
+    ones tried: nothing closed the gap ('unexplained', 11.6 x the background held out). With
+    both trucks' own geometry, B's Ed closes it and is sized within 15 %."""
+    real = tmp_path / "real"
+    c = indep_case(2841, 58, real, "clapper", {"ed": "fixed"})
+    assert c["scope"] == {"ed": "B"}
+    rep = D.diagnose(real, real / "robot.json").to_dict()
+    v = rep["verdict"]
+    assert v["effect"] == "ed", v
+    assert v["best_hypothesis"] == "ed[B]", v
+    ed = c["true"]["effects"]["ed"]["value"]
+    assert abs(v["params"]["ed.value.B"] - ed) < 0.15 * abs(ed - 1.0), (v["params"], ed)
+    assert rep["heldout"]["ratio_after"] < 1.5
+
+
 def test_a_member_that_bends_the_fitting_tracks_away_is_refused(tmp_path: Path) -> None:
     """The independent world's seed 2681 case 31 (traced after that seed was measured): a set
     whose trailer alone has an Es (tyre deflection, 1.0058), driven without turns on the spot.
