@@ -407,8 +407,6 @@ def count_loss_speed(pr: Prepared, ds: np.ndarray, truck: int, P: dict) -> np.nd
 
 PLATEAU_TOL = 0.003  # a tick within 0.3 % of the decoder's count-rate ceiling is saturated
 PLATEAU_SUB = 8  # sub-steps per tick of the hidden speed's integral
-
-
 PLATEAU_MIN_TICKS = 3  # a ceiling is a flat top: this many ticks of the counts reach it
 
 
