@@ -61,6 +61,34 @@ def test_traction_left_to_speed_up_shrinks_with_the_turns_lateral_acceleration()
     assert np.allclose(floor[loose], arc[loose])
 
 
+def _counted_ramp(a: float, q: float, T: float, vmax: float = 500.0, tail: float = 2.0):
+    """A wheel speeding up at a (mm/s^2) to vmax and holding, read by a counter of q mm edges
+    every T s: (pr, counted travel per tick of both wheels)."""
+    t = np.arange(0.0, vmax / a + tail + 1e-9, T)
+    ta = vmax / a
+    x = np.where(t < ta, 0.5 * a * t * t, 0.5 * a * ta * ta + vmax * (t - ta))
+    d = np.diff(np.floor(x / q)) * q
+    return SimpleNamespace(dt=np.full(d.size, T)), np.column_stack([d, d])
+
+
+def test_whole_edges_do_not_spin_a_wheel_the_floor_grips() -> None:
+    """A wheel speeding up at 0.6 m/s^2, counted in 0.35 mm edges every 40 ms: one edge more or
+    less per tick moves the tick's speed change by up to 440 mm/s^2, past a 0.7 or 0.8 m/s^2
+    grip the wheel never reached. Read tick by tick, the traction law spun it where the floor
+    held; with each tick's speed weighed with its neighbours' it loses nothing. Beyond the
+    grip (0.4 m/s^2), the loss is the rate-limited ramp's: the floor lags by (a - g) t and
+    catches up at g, (a - g) t_a^2 / 2 (1 + (a - g) / g) = 104 mm."""
+    from odo_tools.gap.model import slip_traction
+
+    pr, ds = _counted_ramp(600.0, 0.35, 0.04)
+    for grip in (0.7, 0.8):
+        assert np.allclose(slip_traction(pr, ds, grip, 400.0), ds)
+    a, g, ta = 600.0, 400.0, 500.0 / 600.0
+    want = (a - g) * ta * ta / 2 * (1 + (a - g) / g)
+    lost = ds.sum(axis=0) - slip_traction(pr, ds, g / 1000.0, 400.0).sum(axis=0)
+    assert lost == pytest.approx([want, want], rel=0.02)
+
+
 def test_asymmetric_accel_slip_is_named(tmp_path: Path) -> None:
     """Independent world, seed 2701 case 2: a LabMate whose right tyre slips 1.8 x as much as
     its left under acceleration (k 0.079 at 1 m/s^2, power 1.46). Symmetric, the accel law left
