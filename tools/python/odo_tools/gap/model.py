@@ -350,7 +350,7 @@ def slip_traction(pr: Prepared, ds: np.ndarray, a_max: float, b: float) -> np.nd
     lim = _grip(a_max, v[:, 0], v[:, 1], b) * pr.dt  # mm/s per tick
     out = ds.copy()
     for w in (0, 1):
-        ahead = v[:, w] - simlib.rate_limit(np.ascontiguousarray(v[:, w]), lim)
+        ahead = v[:, w] - simlib.rate_limit(v[:, w], lim)
         out[:, w] -= ahead * pr.dt
     return out
 

@@ -140,11 +140,9 @@ def link_from_poses(pose: np.ndarray, robot: Robot) -> np.ndarray:
 def _at_times(t: np.ndarray, link: np.ndarray, tq: np.ndarray) -> np.ndarray:
     """The linkage track (n, 3: two angles in rad, a length in mm) sampled at t, interpolated to
     the times tq (the angles unwrapped first)."""
-    out = np.empty((tq.size, link.shape[1]))
-    for c in range(link.shape[1]):
-        x = np.unwrap(link[:, c]) if c < 2 else link[:, c]
-        out[:, c] = np.interp(tq, t, x)
-    return out
+    x = link.copy()
+    x[:, :2] = np.unwrap(link[:, :2], axis=0)
+    return interp_track(tq, t, x)
 
 
 def _sample_noise(t: np.ndarray, x: np.ndarray) -> np.ndarray:
