@@ -386,6 +386,17 @@ def test_fault_and_flag_bits_are_named_signals_as_the_headers_define_them(db: Da
     assert readme_bits("| Flags bit | name |") == flags
 
 
+def test_gap_reader_reads_the_skipped_state_bits_the_firmware_defines() -> None:
+    """The diagnosis reads a decoder's skipped quadrature states from WHEEL_COUNTS Status with
+    the masks odo_types.h gives the firmware, not a copy that could drift."""
+    from odo_tools.gap import io as gap_io
+
+    text = (SOURCE_DIR / "firmware" / "include" / "odo" / "odo_types.h").read_text()
+    pattern = r"#define ODO_WHEEL_STATUS_(\w+)_SKIPPED\s+0x([0-9A-Fa-f]+)U"
+    masks = {name: int(v, 16) for name, v in re.findall(pattern, text)}
+    assert masks == {"LEFT": gap_io.STATUS_LEFT_SKIPPED, "RIGHT": gap_io.STATUS_RIGHT_SKIPPED}
+
+
 def test_cantools_names_the_faults_of_a_status_frame(db: Database) -> None:
     """What `cantools decode` prints for a STATUS frame: each raised fault by name."""
     status = db.get_message_by_name("STATUS")

@@ -41,6 +41,7 @@ EXTRA_BOUNDS = {
     "count_loss@speed.v0_mm_s": (0.0, 5000.0, 300.0),
     "count_loss@plateau.excess_mm_s": (0.0, 5000.0, 400.0),
     "count_loss@plateau.a_m_s2": (0.05, 20.0, 1.0),
+    "count_loss@flagged.counts": (0.0, 1000.0, 2.0),
     "skid@cornering.deg_per_m_s2": (0.0, 30.0, 1.0),
     "skid@friction.a_lim_m_s2": (0.05, 20.0, 2.0),
     "eb@load.zeta": (0.0, 1.0, 0.05),
@@ -154,6 +155,13 @@ OTHER_LAWS = {
             ("count_loss@plateau.excess_mm_s", "count_loss@plateau.a_m_s2"),
             "a count-rate ceiling: the counts sit on a flat top while the hidden wheel speed "
             "rises at a to the ceiling + excess and back",
+        ),
+        Law(
+            "count_loss",
+            "flagged",
+            ("count_loss@flagged.counts",),
+            "the decoder's own word: a wheel tick flagged with a skipped quadrature state "
+            "(WHEEL_COUNTS Status) lost this many counts",
         ),
     ),
     "rotary_bias": (

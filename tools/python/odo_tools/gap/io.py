@@ -47,6 +47,8 @@ def frame_id(name: str) -> int:
 # the sensor frames the diagnosis reads, by DBC name
 ID_WHEEL = {frame_id("WHEEL_COUNTS_A"): 0, frame_id("WHEEL_COUNTS_B"): 1}
 ID_ROTARY = frame_id("LINK_ROTARY")
+# WHEEL_COUNTS Status bits (can/odometry.dbc; firmware ODO_WHEEL_STATUS_*_SKIPPED)
+STATUS_LEFT_SKIPPED, STATUS_RIGHT_SKIPPED = 0x01, 0x02
 ID_LINEAR = frame_id("LINK_LINEAR")
 FRAME_LEN = {
     fid: int(_dbc().get_message_by_frame_id(fid).length)
@@ -172,6 +174,10 @@ class SensorLog:
     beta_deg: np.ndarray | None = None
     l_mm: np.ndarray | None = None
     fd_skipped: int = 0  # CAN FD lines counted and skipped
+    # (n, trucks, 2) bool: the decoder saw an illegal quadrature transition (a skipped state)
+    # since the previous sample, Status bits 0/1 of WHEEL_COUNTS_A/B (can/odometry.dbc); False
+    # on a tick whose frame was lost
+    skipped: np.ndarray | None = None
 
 
 def read_log(path: str | Path, robot: Robot) -> SensorLog:
@@ -248,6 +254,7 @@ def read_log(path: str | Path, robot: Robot) -> SensorLog:
             raise GapInputError(path, f"gap of {dt[gap[0]]:.3f} s in the wheel counts", line)
     n = t.size
     counts = np.zeros((n, robot.n_trucks, 2), dtype=np.int64)
+    skipped = np.zeros((n, robot.n_trucks, 2), dtype=bool)
     for fid, tr in ID_WHEEL.items():
         sel = ids == fid
         if tr >= robot.n_trucks:
@@ -275,7 +282,11 @@ def read_log(path: str | Path, robot: Robot) -> SensorLog:
                     int(np.nonzero(sel)[0][np.argmax(v >= (1 << bits))]) + 1,
                 )
             counts[:, tr, w] = _fill(v, idx, n)
-    log = SensorLog(str(path), t, counts, fd_skipped=fd)
+        status = decode_signal(pay[sel], lay[fid]["Status"]).astype(np.int64)
+        on = idx >= 0
+        for w, bit in enumerate((STATUS_LEFT_SKIPPED, STATUS_RIGHT_SKIPPED)):
+            skipped[idx[on], tr, w] = (status[on] & bit) != 0
+    log = SensorLog(str(path), t, counts, fd_skipped=fd, skipped=skipped)
     sel_r, sel_l = ids == ID_ROTARY, ids == ID_LINEAR
     if sel_r.any():
         idx = _align(path, ts[sel_r], t, np.nonzero(sel_r)[0])

@@ -36,6 +36,10 @@ class Prepared:
     driven: list[bool] = field(default_factory=lambda: [True, True])
     link: tuple | None = None  # clapper: (l0, alpha0, beta0, l_min, l_max, at_limit) (mm, rad)
     path: str | None = None  # which path the run drove (paths.assign_paths)
+    # (n-1, trucks, 2) bool: the decoder flagged a skipped quadrature state during the tick
+    # (io.SensorLog.skipped of the tick's closing sample), and each truck's mm per count
+    flagged: np.ndarray | None = None
+    count_mm: list[float] = field(default_factory=list)
     shape: str | None = None  # the path without its direction (paths.assign_shapes)
     slip_cache: dict = field(default_factory=dict, repr=False)  # slip_loss results by parameters
     track_cache: dict = field(default_factory=dict, repr=False)  # _track results by parameters
@@ -68,6 +72,8 @@ def prepare(run: RunData, robot: Robot) -> Prepared:
         np.diff(run.log.t_s),
         driven=[t == 0 or robot.vehicle == "clapper" for t in range(T)],
         link=_link_start(run, robot),
+        flagged=None if run.log.skipped is None else run.log.skipped[1:].copy(),
+        count_mm=[robot.mm_per_count(t) for t in range(T)],
     )
 
 
@@ -212,6 +218,8 @@ def floor_travel(
         ds = count_loss_speed(pr, ds, truck, P)
     if P.get("count_loss@plateau.level_mm_s", 0.0) > 0:
         ds = count_loss_plateau(pr, ds, truck, P)
+    if P.get("count_loss@flagged.counts", 0.0) > 0 and pr.flagged is not None:
+        ds = count_loss_flagged(pr, ds, truck, P["count_loss@flagged.counts"])
     for ev in pr.bumps:
         if ev["truck"] != truck:
             continue
@@ -425,6 +433,40 @@ def count_loss_speed(pr: Prepared, ds: np.ndarray, truck: int, P: dict) -> np.nd
     v = np.abs(pr.ds[:, truck, :]) / pr.dt[:, None]
     lam = np.minimum(k * np.maximum(v - v0, 0.0) * 1e-3, 0.9)
     return ds / (1.0 - lam)
+
+
+def count_loss_flagged(pr: Prepared, ds: np.ndarray, truck: int, counts: float) -> np.ndarray:
+    """Counts lost where the decoder says so: a wheel whose decoder flagged a skipped quadrature
+    state during a tick (WHEEL_COUNTS Status, io.SensorLog.skipped) ran `counts` counts further
+    than it counted. A state skipped between two samples is a jump by two states that the
+    counter leaves alone (hal/sim/hctl1100.h), so one skip per flagged tick is 2 counts and the
+    fitted number says how many a flagged tick lost on average."""
+    flag = pr.flagged[:, truck, :]
+    if not flag.any():
+        return ds
+    return ds + np.sign(pr.ds[:, truck, :]) * flag * (counts * pr.count_mm[truck])
+
+
+def skipped_evidence(prs: list) -> str | None:
+    """The decoders' own word on count loss, in words: how many wheel ticks flagged a skipped
+    state, and how fast those wheels ran (None when none did)."""
+    n = ticks = 0
+    fast = []
+    for pr in prs:
+        if pr.flagged is None:
+            continue
+        ticks += pr.flagged.size
+        n += int(pr.flagged.sum())
+        if pr.flagged.any():
+            v = np.abs(pr.ds) / pr.dt[:, None, None]
+            fast.append(v[pr.flagged])
+    if n == 0:
+        return None
+    v = np.concatenate(fast)
+    return (
+        f"the wheel decoders flagged a skipped quadrature state on {n} of {ticks} wheel ticks, "
+        f"at {np.percentile(v, 5):.0f}-{v.max():.0f} mm/s"
+    )
 
 
 PLATEAU_TOL = 0.003  # a tick within 0.3 % of the decoder's count-rate ceiling is saturated
