@@ -46,6 +46,8 @@ LAW_WORDS = {
     "tau, and the floor follows it by at most a_max",
     "speed": "a fraction of the counts lost above a wheel speed",
     "growth": "one tyre's rolling radius grows with the square of its speed, beside a fixed Ed",
+    "flagged": "the wheel decoders' own word: each wheel tick they flagged with a skipped "
+    "quadrature state lost this many counts (one skipped state: 2)",
     "plateau": "a count-rate ceiling: the counts sit on a flat top while the hidden wheel speed "
     "rises beyond it and back",
     "cornering": "linear cornering stiffness: the tyres run at a slip angle proportional to the "
@@ -89,6 +91,7 @@ def unit(key: str) -> str:
             "a_m_s2": "m/s^2",
             "a_lim_m_s2": "m/s^2",
             "zeta": "1",
+            "counts": "counts per flagged tick",
         }.get(p, "")
         if p.endswith("_deg"):  # the once-per-turn terms of a joint encoder's offset
             u = "deg"
