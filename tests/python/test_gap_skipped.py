@@ -110,7 +110,7 @@ def test_a_loss_below_the_background_is_named_from_the_decoders_flags(tmp_path: 
     within the background with and without the loss modelled; the flags name count loss, and
     the flagged law sizes it at about one skipped state (2 counts) per flagged tick. With the
     same runs' Status cleared, the verdict is "no significant gap": the flags, not the gap,
-    named it."""
+    named it. From return errors, which cannot size a count loss, the reason gives the flags."""
     from odo_tools.gap.diagnose import diagnose
 
     real = tmp_path / "real"
@@ -123,6 +123,10 @@ def test_a_loss_below_the_background_is_named_from_the_decoders_flags(tmp_path: 
     assert v["evidence"]["heldout_ratio_before"] < 2.0
     assert "flagged a skipped quadrature state" in v["reason"]
     assert "count_loss" in rep["proposals"]
+    # return errors cannot size a count loss (catalog): the flags are reported, not named
+    ret = diagnose(real, real / "robot.json", mode="returns").to_dict()["verdict"]
+    assert ret["effect"] != "count_loss"
+    assert "returns mode cannot size" in ret["reason"] and "skipped quadrature" in ret["reason"]
     assert sum(_clear_status(p) for p in real.glob("*.log")) > 100
     rep = diagnose(real, real / "robot.json", mode="truth").to_dict()
     assert rep["verdict"]["effect"] == "no significant gap", rep["verdict"]

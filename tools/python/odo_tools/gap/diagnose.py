@@ -1049,11 +1049,16 @@ def _decoders_word(ds: Dataset, sel: Selection, rk: Ranking, jd: Judgement) -> J
     that cost a LabMate 0.1 % of a sprint's travel left its held-out runs at 0.82 x the
     background (independent dev seed 2831 case 27) while its decoders flagged 740 ticks, and
     the flagged law fitted 2.2 counts per flagged tick: one skipped state each. A named
-    verdict is kept as it is: a gap the decoders' flags do not close is another effect's."""
+    verdict is kept as it is: a gap the decoders' flags do not close is another effect's. A
+    mode that cannot size count loss (returns, linkage: catalog) gives the flags in its reason."""
     said = skipped_evidence(ds.prs)
-    if jd.verdict != "no significant gap" or said is None:
+    if said is None:
         return jd
     if "count_loss" not in catalog.hypotheses(ds.mode, ds.robot.vehicle):
+        why = catalog.not_identifiable(ds.mode, ds.robot.vehicle).get("count_loss", "")
+        jd.reason += f"; {said}: count loss, which {ds.mode} mode cannot size ({why})"
+        return jd
+    if jd.verdict != "no significant gap":
         return jd
     cl = [f for f in rk.cands if f.hyp is not None and f.hyp.families == ("count_loss",)]
     if not cl:
