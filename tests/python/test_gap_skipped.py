@@ -9,7 +9,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from gap_support import BUILD, SRC, indep_case
+from gap_support import BUILD, SRC, indep_named
 
 
 @pytest.fixture(autouse=True)
@@ -113,12 +113,10 @@ def test_a_loss_below_the_background_is_named_from_the_decoders_flags(tmp_path: 
     named it. From return errors, which cannot size a count loss, the reason gives the flags."""
     from odo_tools.gap.diagnose import diagnose
 
+    laws = {"count_loss": "missed"}
+    _, rep = indep_named(2831, 27, tmp_path, "labmate", laws, "count_loss", "flagged")
     real = tmp_path / "real"
-    indep_case(2831, 27, real, "labmate", {"count_loss": "missed"})
-    rep = diagnose(real, real / "robot.json", mode="truth").to_dict()
     v = rep["verdict"]
-    assert v["effect"] == "count_loss", v
-    assert v["laws"]["count_loss"]["law"] == "flagged", v["laws"]
     assert 1.5 <= v["params"]["count_loss@flagged.counts"] <= 4.0, v["params"]
     assert v["evidence"]["heldout_ratio_before"] < 2.0
     assert "flagged a skipped quadrature state" in v["reason"]
