@@ -47,9 +47,10 @@ def frame_id(name: str) -> int:
 # the sensor frames the diagnosis reads, by DBC name
 ID_WHEEL = {frame_id("WHEEL_COUNTS_A"): 0, frame_id("WHEEL_COUNTS_B"): 1}
 ID_ROTARY = frame_id("LINK_ROTARY")
-# WHEEL_COUNTS Status bits (can/odometry.dbc; firmware ODO_WHEEL_STATUS_*_SKIPPED)
-STATUS_LEFT_SKIPPED, STATUS_RIGHT_SKIPPED = 0x01, 0x02
 ID_LINEAR = frame_id("LINK_LINEAR")
+# WHEEL_COUNTS Status bits (can/odometry.dbc; firmware ODO_WHEEL_STATUS_*_SKIPPED, which
+# tests/python/test_can_dbc.py holds these equal to)
+STATUS_LEFT_SKIPPED, STATUS_RIGHT_SKIPPED = 0x01, 0x02
 FRAME_LEN = {
     fid: int(_dbc().get_message_by_frame_id(fid).length)
     for fid in (*ID_WHEEL, ID_ROTARY, ID_LINEAR)
