@@ -9,7 +9,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from gap_support import BUILD, SRC, indep_named
+from gap_support import BUILD, SRC, indep_case, indep_named
 
 
 @pytest.fixture(autouse=True)
@@ -129,3 +129,22 @@ def test_a_loss_below_the_background_is_named_from_the_decoders_flags(tmp_path: 
     rep = diagnose(real, real / "robot.json", mode="truth").to_dict()
     assert rep["verdict"]["effect"] == "no significant gap", rep["verdict"]
     assert "count_loss" not in rep["proposals"]
+
+
+def test_count_loss_the_decoders_flag_joins_a_named_effect(tmp_path: Path) -> None:
+    """Independent world, seed 2771 case 43 (a dev seed): a LabMate's traction slip and a decoder
+    rate limit that flags its overruns. Without the flags the verdict is slip alone; with them
+    the ranking's slip gets the best count-loss law beside it, and the pair is named because it
+    is named on the held-out runs too."""
+    from odo_tools.gap.diagnose import diagnose
+
+    real = tmp_path / "real"
+    indep_case(2771, 43, real, "labmate", {"count_loss": "rate_limit", "slip": "traction"})
+    v = diagnose(real, real / "robot.json", mode="truth").to_dict()["verdict"]
+    assert v["effect"] == "count_loss+slip", v
+    assert v["laws"]["slip"]["law"] in ("traction", "motor"), v["laws"]  # traction saturation
+    assert "flagged a skipped quadrature state" in v["reason"]
+    assert v["evidence"]["heldout_ratio_after"] < v["evidence"]["heldout_ratio_before"]
+    assert sum(_clear_status(p) for p in real.glob("*.log")) > 10
+    v = diagnose(real, real / "robot.json", mode="truth").to_dict()["verdict"]
+    assert v["effect"] == "slip", v

@@ -1048,9 +1048,11 @@ def _decoders_word(ds: Dataset, sel: Selection, rk: Ranking, jd: Judgement) -> J
     count-loss candidate, whose misfit on the held-out runs the report gives. Missed edges
     that cost a LabMate 0.1 % of a sprint's travel left its held-out runs at 0.82 x the
     background (independent dev seed 2831 case 27) while its decoders flagged 740 ticks, and
-    the flagged law fitted 2.2 counts per flagged tick: one skipped state each. A named
-    verdict is kept as it is: a gap the decoders' flags do not close is another effect's. A
-    mode that cannot size count loss (returns, linkage: catalog) gives the flags in its reason."""
+    the flagged law fitted 2.2 counts per flagged tick: one skipped state each. A verdict
+    that names other effects gets count loss beside them where that is named on the held-out
+    runs too (`_with_count_loss`); "unexplained" stays: a gap nothing closes is not the flags'.
+    A mode that cannot size count loss (returns, linkage: catalog) gives the flags in its
+    reason."""
     said = skipped_evidence(ds.prs)
     if said is None:
         return jd
@@ -1058,9 +1060,11 @@ def _decoders_word(ds: Dataset, sel: Selection, rk: Ranking, jd: Judgement) -> J
         why = catalog.not_identifiable(ds.mode, ds.robot.vehicle).get("count_loss", "")
         jd.reason += f"; {said}: count loss, which {ds.mode} mode cannot size ({why})"
         return jd
-    if jd.verdict != "no significant gap":
+    if jd.verdict == "unexplained":
         return jd
     cl = [f for f in rk.cands if f.hyp is not None and f.hyp.families == ("count_loss",)]
+    if jd.verdict != "no significant gap":
+        return _with_count_loss(ds, sel, rk, jd, cl, said)
     if not cl:
         return jd
     rk.best = min(cl, key=lambda f: f.bic)
@@ -1075,6 +1079,45 @@ def _decoders_word(ds: Dataset, sel: Selection, rk: Ranking, jd: Judgement) -> J
         f"{again.held.ratio_after:.2f} x)"
     )
     return again
+
+
+def _with_count_loss(
+    ds: Dataset, sel: Selection, rk: Ranking, jd: Judgement, cl: list[Fit], said: str
+) -> Judgement:
+    """A named verdict without count loss while the decoders flagged skipped states: the named
+    effects with the best count-loss law beside them, fitted on the fitting runs (or taken from
+    the ranking), judged in its place. Kept where it is named too; otherwise the verdict stays
+    and its reason gives the flags."""
+    fams = set(rk.best.hyp.families)
+    if "count_loss" in fams or not cl:
+        return jd
+    want = fams | {"count_loss"}
+    have = [f for f in rk.cands if f.hyp is not None and set(f.hyp.families) == want]
+    if have:
+        pair = min(have, key=lambda f: f.bic)
+    else:
+        law = min(cl, key=lambda f: f.bic).hyp
+        fprs = [ds.prs[i] for i in sel.fit]
+        fb = rk.best.bumps if rk.best.hyp.has_bumps else None
+        pair = fit_hypothesis(
+            rk.best.hyp + law,
+            rk.prob,
+            fprs,
+            _sig_head(rk.prob, ds.items[0].channels()),
+            fb,
+            rk.best.model_params(),
+        )
+        if not _real(pair):
+            return jd
+    kept = (rk.best, ds.instrument, ds.items)
+    rk.best = pair
+    again = judge(ds, sel, rk)
+    if again.verdict == pair.label:
+        again.reason += f"; {said}"
+        return again
+    rk.best, ds.instrument, ds.items = kept
+    jd.reason += f"; {said}, and {pair.name} is not named on the held-out runs ({again.reason})"
+    return jd
 
 
 LATENCY_MOVE_S = 0.005
