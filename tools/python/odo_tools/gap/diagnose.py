@@ -1088,8 +1088,10 @@ def _with_count_loss(
     effects with the best count-loss law beside them, fitted on the fitting runs (or taken from
     the ranking), judged in its place. Kept where it is named too; otherwise the verdict stays
     and its reason gives the flags."""
+    if rk.best.hyp is None or not cl:
+        return jd
     fams = set(rk.best.hyp.families)
-    if "count_loss" in fams or not cl:
+    if "count_loss" in fams:
         return jd
     want = fams | {"count_loss"}
     have = [f for f in rk.cands if f.hyp is not None and set(f.hyp.families) == want]
