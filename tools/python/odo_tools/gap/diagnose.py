@@ -360,11 +360,7 @@ def rank(ds: Dataset, sel: Selection, progress: Progress = None) -> Ranking:
         # shows only through its mean, which shortens every turn like an Eb (its alias; the
         # report lists it under "not identifiable")
         hyps = [h for h in hyps if "roughness" not in h.families]
-    hyps += [
-        h
-        for h in hypotheses.tried_laws(proposals, ds.mode, ds.robot.vehicle)
-        if skipped is not None or "count_loss@flagged" not in h.name
-    ]
+    hyps += hypotheses.tried_laws(proposals, ds.mode, ds.robot.vehicle, skipped is not None)
     trucks = truck_excess(prob.items, {}, prob.sigma) if ds.robot.n_trucks == 2 else []
     scoped = None
     if trucks and max(trucks) >= hypotheses.TRUCK_SHARE:

@@ -310,15 +310,20 @@ def unproposed(h: Hypothesis, proposals: dict) -> bool:
     )
 
 
-def tried_laws(proposals: dict, mode: str, vehicle: str) -> list[Hypothesis]:
+# laws that act only on ticks the wheel decoders flagged (model.count_loss_flagged): nothing to
+# fit where they flagged none
+NEEDS_FLAGS = ("count_loss@flagged",)
+
+
+def tried_laws(proposals: dict, mode: str, vehicle: str, flagged: bool = False) -> list[Hypothesis]:
     """The other laws a ranking fits beside the catalog's: ALWAYS's, and every law of each
-    family the phases propose (`propose`)."""
+    family the phases propose (`propose`); NEEDS_FLAGS's only where the decoders `flagged`."""
     out = []
     for fam in dict.fromkeys([*(a.split("@")[0] for a in ALWAYS), *proposals]):
         laws = other_laws(fam, mode, vehicle)
         if fam not in proposals and fam not in ALWAYS:
             laws = [h for h in laws if h.name in ALWAYS]
-        out += laws
+        out += [h for h in laws if flagged or h.name not in NEEDS_FLAGS]
     return out
 
 
