@@ -484,7 +484,18 @@ def headline(s: dict) -> dict:
         "diagnose_10runs_s",
         "diagnose_10runs_s_max",
     )
-    return {k: s.get(k) for k in keys}
+    out = {k: s.get(k) for k in keys}
+    vis = s.get("visible_only") or {}
+    if vis:
+        out["visible_only"] = {
+            m: {
+                "top1": v["top1_accuracy"][0],
+                "ooc_unexplained": v["unexplained_rate_out_of_catalog"][0],
+                "unseen": v["unseen_cases"],
+            }
+            for m, v in vis.items()
+        }
+    return out
 
 
 def _summ(r: dict) -> dict:
@@ -534,7 +545,26 @@ def scored_in(c: dict, mode: str) -> bool:
     ok = set(catalog.identifiable(mode, c["vehicle"]))
     if not c.get("accuracy_stated", False):
         ok -= NEEDS_STATED_ACCURACY.get(mode, set())
-    return c["kind"] in ("single", "pair") and all(e in ok for e in c["effects"])
+    return (
+        c["kind"] in ("single", "pair") and all(e in ok for e in c["effects"]) and reaches(c, mode)
+    )
+
+
+def reaches(c: dict, mode: str) -> bool:
+    """Whether every effect of the case acts where a mode's evidence looks, as the world that
+    drew it declares (the independent world's key `visible`: an effect on a set's trailer never
+    reaches truck A's return errors, a truth clock's drift no return error or linkage reading);
+    True where the world declares nothing."""
+    vis = c.get("visible") or {}
+    return all(vis.get(e, {}).get(mode, True) for e in c["effects"])
+
+
+def seen_in(c: dict, mode: str) -> bool | None:
+    """Whether the case's effects reach a mode's evidence beyond what the floor and sensors
+    leave alone, by the generator's own twin measure (indep/imprint.py); None where the world
+    did not measure it (the simulator's world, linkage evidence, no-effect cases)."""
+    im = (c.get("imprint") or {}).get(mode)
+    return None if im is None else bool(im["visible"])
 
 
 def score(cases: list[dict], results: list[dict]) -> dict:
@@ -547,26 +577,45 @@ def score(cases: list[dict], results: list[dict]) -> dict:
             return None
         return norm(r["report"]["verdict"]["effect"]) if "report" in r else "error"
 
-    per_mode, fa_mode, un_mode = {}, {}, {}
+    rate = lambda k, n: (k / n if n else float("nan"), n)  # noqa: E731
+    per_mode, fa_mode, un_mode, vis_mode = {}, {}, {}, {}
     for m in ("truth", "returns", "linkage"):
         ok = tot = 0
         fa, un = [0, 0], [0, 0]
+        vis = {"top1": [0, 0], "unexplained": [0, 0], "unseen": [0, 0]}
         for c in cases:
             pred = pred_of(byreal.get((f"case-{c['case']:03d}", m)))
             if pred is None:
                 continue
+            seen = seen_in(c, m)
             if scored_in(c, m):
                 tot += 1
                 ok += pred == truth_label(c)
             if c["kind"] == "none":
                 fa[1] += 1
                 fa[0] += pred != "no significant gap"
-            if c["kind"] == "ooc":
+            if c["kind"] == "ooc" and reaches(c, m):
                 un[1] += 1
                 un[0] += pred == "unexplained"
-        per_mode[m] = (ok / tot if tot else float("nan"), tot)
-        fa_mode[m] = (fa[0] / fa[1] if fa[1] else float("nan"), fa[1])
-        un_mode[m] = (un[0] / un[1] if un[1] else float("nan"), un[1])
+            if seen is False and (scored_in(c, m) or (c["kind"] == "ooc" and reaches(c, m))):
+                vis["unseen"][1] += 1
+                vis["unseen"][0] += pred == "no significant gap"
+            elif seen and scored_in(c, m):
+                vis["top1"][1] += 1
+                vis["top1"][0] += pred == truth_label(c)
+            elif seen and c["kind"] == "ooc" and reaches(c, m):
+                vis["unexplained"][1] += 1
+                vis["unexplained"][0] += pred == "unexplained"
+        per_mode[m] = rate(ok, tot)
+        fa_mode[m] = rate(*fa)
+        un_mode[m] = rate(*un)
+        if any(seen_in(c, m) is not None for c in cases):
+            vis_mode[m] = {
+                "top1_accuracy": rate(*vis["top1"]),
+                "unexplained_rate_out_of_catalog": rate(*vis["unexplained"]),
+                "unseen_cases": vis["unseen"][1],
+                "unseen_judged_no_gap": vis["unseen"][0],
+            }
     conf: dict[str, dict[str, int]] = {}
     rel, loc, shr, times, per_case = [], [], [], [], []
     for c in cases:
@@ -638,6 +687,7 @@ def score(cases: list[dict], results: list[dict]) -> dict:
         "unexplained_rate_out_of_catalog": un_mode["truth"][0],
         "out_of_catalog_cases": un_mode["truth"][1],
         "unexplained_rate_out_of_catalog_by_mode": {m: v[0] for m, v in un_mode.items()},
+        "visible_only": vis_mode,
         "param_rel_err_median": med(rel),
         "bump_loc_err_mm_median": med(loc),
         "shrink_median": med(shr),
@@ -646,9 +696,14 @@ def score(cases: list[dict], results: list[dict]) -> dict:
         "confusion": conf,
         "per_case": per_case,
         "scoring": "top-1 per mode over catalog cases (single and pair) whose effects the catalog "
-        "says that mode identifies on that vehicle (evidence 'yes'); false alarms: no-effect "
-        "cases not judged 'no significant gap', per mode; out-of-catalog cases judged "
-        "'unexplained', per mode; the other figures from the continuous-truth verdicts",
+        "says that mode identifies on that vehicle (evidence 'yes') and that act where the mode "
+        "looks (the world's `visible`); false alarms: no-effect cases not judged 'no "
+        "significant gap', per mode; out-of-catalog cases that act where the mode looks judged "
+        "'unexplained', per mode; the other figures from the continuous-truth verdicts. "
+        "visible_only (worlds that measure it): the same top-1 and out-of-catalog figures over "
+        "the cases whose effects the generator's twin measure finds at least twice the floor's "
+        "and sensors' own imprint in that mode's evidence; unseen_cases: the scored cases it "
+        "does not, and how many of them were judged 'no significant gap'",
     }
 
 

@@ -21,7 +21,8 @@ draw_case(rng, k) -> dict: case k's hidden key. Keys: case, world ("independent"
 simulate_case(case, real, seed) -> dict: writes the recorded data into the new folder `real`
     and returns extra key fields (events: bump hits with run, truck, wheel, x_mm, y_mm (floor
     frame, the truth's), t_s (robot clock, as the files are stamped), t_run_s, excess_mm;
-    runs; link_clamps; generation_s).
+    runs; link_clamps; imprint: per mode, how far the effect reaches that evidence against a
+    no-effect twin (imprint.py); generation_s).
 """
 
 from __future__ import annotations

@@ -20,7 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from . import floor as fl
-from . import laws, paths
+from . import imprint, laws, paths
 from .cases import limits
 from .control import Controller
 from .world import Cable, World, truck_models
@@ -386,6 +386,7 @@ def simulate_case(case: dict, real: Path, seed: int, progress=None) -> dict:
         raise FileExistsError(f"{real}: exists; the world writes only into a new folder")
     t_start = time.perf_counter()
     sim = run_world(case, seed, progress)
+    imp = imprint.measure(case, sim, seed)
     ss = np.random.SeedSequence([seed, case["case"], 1])
     rng_log, rng_truth, rng_ret, rng_ep = (np.random.default_rng(s) for s in ss.spawn(4))
     tmp = real.parent / f".{real.name}.tmp-{os.getpid()}"
@@ -450,6 +451,7 @@ def simulate_case(case: dict, real: Path, seed: int, progress=None) -> dict:
         "events": events,
         "runs": runs,
         "link_clamps": [int(x) for x in sim["clamps"]],
+        "imprint": imp,
         "generation_s": round(time.perf_counter() - t_start, 3),
     }
 
