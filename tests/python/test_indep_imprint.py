@@ -134,6 +134,15 @@ def test_scores_count_a_case_only_where_its_effect_acts_and_split_the_unseen() -
         "visible": {"gear_backlash": {"truth": True, "returns": True, "linkage": True}},
         "imprint": _im(False, False),
     }
+    rotary = {
+        "case": 4,
+        "vehicle": "set",
+        "kind": "single",
+        "effects": ["rotary_bias"],
+        "visible": {"rotary_bias": {"truth": True, "returns": False, "linkage": True}},
+        "imprint": _im(None, None),  # an effect on the linkage's sensors: not measured
+    }
+    assert scored_in(rotary, "truth")
     assert scored_in(ed_a, "returns") and not scored_in(ed_b, "returns")
     assert scored_in(ed_b, "truth")
     res = [
@@ -145,8 +154,9 @@ def test_scores_count_a_case_only_where_its_effect_acts_and_split_the_unseen() -
         _res(2, "returns", "unexplained"),
         _res(3, "truth", "no significant gap"),
         _res(3, "returns", "no significant gap"),
+        _res(4, "truth", "rotary_bias"),
     ]
-    s = score([ed_b, ed_a, clock, faint], res)
+    s = score([ed_b, ed_a, clock, faint, rotary], res)
     # returns: the set's truck-B Ed is not scored there; the clock drift is not an out-of-catalog
     # case of that mode (judged "unexplained" there, it would count); the faint backlash is one,
     # and it was missed
@@ -156,12 +166,12 @@ def test_scores_count_a_case_only_where_its_effect_acts_and_split_the_unseen() -
     vis = s["visible_only"]
     assert vis["truth"]["unexplained_rate_out_of_catalog"] == (1.0, 1)
     assert vis["truth"]["unseen_cases"] == 1 and vis["truth"]["unseen_judged_no_gap"] == 1
-    assert vis["truth"]["top1_accuracy"] == (1.0, 2)
+    assert vis["truth"]["top1_accuracy"] == (1.0, 3)  # the unmeasured one counts as before
     assert vis["returns"]["unseen_cases"] == 1 and vis["returns"]["top1_accuracy"] == (1.0, 1)
     assert "linkage" not in vis
     # a world that measures nothing (the simulator's) gets no second figure
     plain = [
         {k: v for k, v in c.items() if k not in ("imprint", "visible")}
-        for c in (ed_b, ed_a, clock, faint)
+        for c in (ed_b, ed_a, clock, faint, rotary)
     ]
     assert score(plain, res)["visible_only"] == {}

@@ -600,10 +600,10 @@ def score(cases: list[dict], results: list[dict]) -> dict:
             if seen is False and (scored_in(c, m) or (c["kind"] == "ooc" and reaches(c, m))):
                 vis["unseen"][1] += 1
                 vis["unseen"][0] += pred == "no significant gap"
-            elif seen and scored_in(c, m):
+            elif scored_in(c, m):  # seen, or not measured (linkage sensors): as before
                 vis["top1"][1] += 1
                 vis["top1"][0] += pred == truth_label(c)
-            elif seen and c["kind"] == "ooc" and reaches(c, m):
+            elif c["kind"] == "ooc" and reaches(c, m):
                 vis["unexplained"][1] += 1
                 vis["unexplained"][0] += pred == "unexplained"
         per_mode[m] = rate(ok, tot)
