@@ -103,45 +103,27 @@ def _res(k: int, mode: str, verdict: str) -> dict:
     }
 
 
-def _im(truth: bool | None, returns: bool | None) -> dict:
-    e = lambda v: None if v is None else {"visible": v, "ratio": 3.0 if v else 0.5}  # noqa: E731
-    return {"truth": e(truth), "returns": e(returns), "linkage": None}
+def _key(k: int, vehicle: str, kind: str, effect: str, acts: str, seen: tuple) -> dict:
+    """A hand-made key: `acts`, the modes (t, r, l) the world says the effect reaches; `seen`,
+    the imprint's verdict in truth and returns mode (None: not measured)."""
+    im = lambda v: None if v is None else {"visible": v, "ratio": 3.0 if v else 0.5}  # noqa: E731
+    return {
+        "case": k,
+        "vehicle": vehicle,
+        "kind": kind,
+        "effects": [effect],
+        "visible": {effect: {m: m[0] in acts for m in ("truth", "returns", "linkage")}},
+        "imprint": {"truth": im(seen[0]), "returns": im(seen[1]), "linkage": None},
+    }
 
 
 def test_scores_count_a_case_only_where_its_effect_acts_and_split_the_unseen() -> None:
-    ed_b = {
-        "case": 0,
-        "vehicle": "set",
-        "kind": "single",
-        "effects": ["ed"],
-        "visible": {"ed": {"truth": True, "returns": False, "linkage": True}},
-        "imprint": _im(True, True),
-    }
-    ed_a = {**ed_b, "case": 1, "visible": {"ed": {"truth": True, "returns": True, "linkage": True}}}
-    clock = {
-        "case": 2,
-        "vehicle": "labmate",
-        "kind": "ooc",
-        "effects": ["clock_drift"],
-        "visible": {"clock_drift": {"truth": True, "returns": False, "linkage": False}},
-        "imprint": _im(True, False),
-    }
-    faint = {
-        "case": 3,
-        "vehicle": "labmate",
-        "kind": "ooc",
-        "effects": ["gear_backlash"],
-        "visible": {"gear_backlash": {"truth": True, "returns": True, "linkage": True}},
-        "imprint": _im(False, False),
-    }
-    rotary = {
-        "case": 4,
-        "vehicle": "set",
-        "kind": "single",
-        "effects": ["rotary_bias"],
-        "visible": {"rotary_bias": {"truth": True, "returns": False, "linkage": True}},
-        "imprint": _im(None, None),  # an effect on the linkage's sensors: not measured
-    }
+    ed_b = _key(0, "set", "single", "ed", "tl", (True, True))  # on the trailer
+    ed_a = _key(1, "set", "single", "ed", "trl", (True, True))
+    clock = _key(2, "labmate", "ooc", "clock_drift", "t", (True, False))
+    faint = _key(3, "labmate", "ooc", "gear_backlash", "trl", (False, False))
+    # an effect on the linkage's sensors: its imprint is not measured
+    rotary = _key(4, "set", "single", "rotary_bias", "tl", (None, None))
     assert scored_in(rotary, "truth")
     assert scored_in(ed_a, "returns") and not scored_in(ed_b, "returns")
     assert scored_in(ed_b, "truth")

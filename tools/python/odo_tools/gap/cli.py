@@ -91,22 +91,31 @@ def main(argv: list[str] | None = None) -> int:
         "protractor (default: a folder's instrument.json, else none): the returns' spread is "
         "judged against the larger of it and the runs' own spread",
     )
-    d.add_argument("--out", required=True)
+    d.add_argument(
+        "--out",
+        required=True,
+        help="new folder (or one odo-gap wrote): report.json, report.md and the plots",
+    )
     d.add_argument(
         "--force",
         action="store_true",
         help="write into a non-empty OUT odo-gap did not write (same-named files replaced, "
         "nothing removed)",
     )
-    d.add_argument("--quiet", action="store_true")
+    d.add_argument("--quiet", action="store_true", help="no progress output")
     b = sub.add_parser(
         "blind",
         help="the withheld-effect check: generate, diagnose, score",
         description="Draw cases with hidden effects, simulate their recordings in one or both "
         "worlds, diagnose them in processes that cannot open the keys, and score.",
     )
-    b.add_argument("--cases", type=int, default=60)
-    b.add_argument("--seed", type=int, default=1)
+    b.add_argument("--cases", type=int, default=60, help="cases drawn per world (default 60)")
+    b.add_argument(
+        "--seed",
+        type=int,
+        default=1,
+        help="the draw's seed (default 1); report figures only from seeds never run before",
+    )
     b.add_argument(
         "--world",
         choices=["sim", "independent", "both"],
@@ -114,7 +123,12 @@ def main(argv: list[str] | None = None) -> int:
         help="sim: host_sim with hidden effects; independent: a generator that shares no code or "
         "effect law with it (validation.indep); both: each, scored separately",
     )
-    b.add_argument("--out", required=True)
+    b.add_argument(
+        "--out",
+        required=True,
+        help="new folder: per world keys/, results.json, scores.json (every figure, and "
+        "visible_only: the same over the cases whose effect leaves an imprint), scores.png",
+    )
     b.add_argument(
         "--force",
         action="store_true",
@@ -122,7 +136,7 @@ def main(argv: list[str] | None = None) -> int:
         "nothing removed)",
     )
     b.add_argument("--workers", type=int, default=2, help="processes (at most 2)")
-    b.add_argument("--quiet", action="store_true")
+    b.add_argument("--quiet", action="store_true", help="no progress output")
     a = ap.parse_args(argv)
     try:
         if a.cmd == "diagnose":
