@@ -587,23 +587,24 @@ def score(cases: list[dict], results: list[dict]) -> dict:
             pred = pred_of(byreal.get((f"case-{c['case']:03d}", m)))
             if pred is None:
                 continue
-            seen = seen_in(c, m)
-            if scored_in(c, m):
+            scored = scored_in(c, m)
+            ooc = c["kind"] == "ooc" and reaches(c, m)
+            if scored:
                 tot += 1
                 ok += pred == truth_label(c)
             if c["kind"] == "none":
                 fa[1] += 1
                 fa[0] += pred != "no significant gap"
-            if c["kind"] == "ooc" and reaches(c, m):
+            if ooc:
                 un[1] += 1
                 un[0] += pred == "unexplained"
-            if seen is False and (scored_in(c, m) or (c["kind"] == "ooc" and reaches(c, m))):
+            if seen_in(c, m) is False and (scored or ooc):
                 vis["unseen"][1] += 1
                 vis["unseen"][0] += pred == "no significant gap"
-            elif scored_in(c, m):  # seen, or not measured (linkage sensors): as before
+            elif scored:  # seen, or not measured (linkage sensors): as before
                 vis["top1"][1] += 1
                 vis["top1"][0] += pred == truth_label(c)
-            elif c["kind"] == "ooc" and reaches(c, m):
+            elif ooc:
                 vis["unexplained"][1] += 1
                 vis["unexplained"][0] += pred == "unexplained"
         per_mode[m] = rate(ok, tot)
