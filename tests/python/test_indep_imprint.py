@@ -37,13 +37,16 @@ def _with(c: dict, name: str, **e) -> dict:
 
 
 def _measure(c: dict, seed: int = 11) -> dict:
-    return imprint.measure(c, run_world(c, seed), seed)
+    return imprint.measure(c, run_world(c, seed), run_world(imprint.twin_case(c), seed))
 
 
 def test_a_case_without_an_effect_is_not_measured(tmp_path: Path) -> None:
     c = _case()
     extra = indep.simulate_case(c, tmp_path / "real", 11)
     assert extra["imprint"] == {"truth": None, "returns": None, "linkage": None}
+    # an effect on the linkage's sensors is not measured either: no twin is run
+    assert imprint.twin_case(_with(c, "rotary_bias", law="constant", alpha_deg=1.0)) is None
+    assert imprint.twin_case(_with(c, "gear_backlash", law="play", play_deg=3.0)) is not None
 
 
 def test_the_imprint_grows_with_the_effect_and_a_faint_one_stays_unseen() -> None:
@@ -76,7 +79,7 @@ def test_a_truth_clock_drift_reaches_only_the_truth_and_within_its_bound() -> No
     cd = _with(c, "clock_drift", law="linear", ppm=ppm, offset_s=0.02)
     cd["true"]["effects"]["clock_drift"]["truck"] = "vehicle"
     sim = run_world(cd, 11)
-    got = imprint.measure(cd, sim, 11)
+    got = imprint.measure(cd, sim, run_world(imprint.twin_case(cd), 11))
     assert got["returns"]["imprint_mm"] == 0.0 and got["returns"]["imprint_deg"] == 0.0
     assert not got["returns"]["visible"]
     b_mm, b_deg = [], []

@@ -95,16 +95,22 @@ def _entry(im_mm: float, im_deg: float, bg_mm: float, bg_deg: float) -> dict:
     }
 
 
-def measure(case: dict, sim: dict, seed: int) -> dict:
-    """The case's imprint per mode (module doc); `sim` is run_world(case, seed)."""
-    from .simulate import run_world
-
+def twin_case(case: dict) -> dict | None:
+    """The case with every effect removed, or None where nothing is measured (no effect, or an
+    effect on the linkage's sensors)."""
     names = set(case["true"]["effects"])
     if not names or names & LINKAGE_SENSORS:
+        return None
+    twin = copy.deepcopy(case)
+    twin["true"]["effects"] = {}
+    return twin
+
+
+def measure(case: dict, sim: dict, twin: dict | None) -> dict:
+    """The case's imprint per mode (module doc): `sim` is simulate.run_world(case, seed), `twin`
+    run_world(twin_case(case), seed) with the same seed (None where twin_case is None)."""
+    if twin is None:
         return {"truth": None, "returns": None, "linkage": None}
-    twin_case = copy.deepcopy(case)
-    twin_case["true"]["effects"] = {}
-    twin = run_world(twin_case, seed)
     fid = case["fidelity"]
     nt = sim["onboard"].shape[2]
     tm, td, bm, bd = [], [], [], []  # truth: imprint and twin error, mm and rad
@@ -112,7 +118,7 @@ def measure(case: dict, sim: dict, seed: int) -> dict:
     for r in range(len(case["plan"])):
         for ti in range(nt):
             t, e, true = tracks(case, sim, r, ti)
-            _, et, _ = tracks(twin_case, twin, r, ti)
+            _, et, _ = tracks(case, twin, r, ti)  # the twin's clock and plan are the case's
             n = min(len(e), len(et))
             d = e[:n] - et[:n] - _clock(case, t[:n], true[:n])
             d[:, 2] = laws.wrap(d[:, 2])

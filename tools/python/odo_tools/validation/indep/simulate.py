@@ -386,7 +386,8 @@ def simulate_case(case: dict, real: Path, seed: int, progress=None) -> dict:
         raise FileExistsError(f"{real}: exists; the world writes only into a new folder")
     t_start = time.perf_counter()
     sim = run_world(case, seed, progress)
-    imp = imprint.measure(case, sim, seed)
+    twin = imprint.twin_case(case)  # the same case without its effects: how far they reach
+    imp = imprint.measure(case, sim, None if twin is None else run_world(twin, seed))
     ss = np.random.SeedSequence([seed, case["case"], 1])
     rng_log, rng_truth, rng_ret, rng_ep = (np.random.default_rng(s) for s in ss.spawn(4))
     tmp = real.parent / f".{real.name}.tmp-{os.getpid()}"
