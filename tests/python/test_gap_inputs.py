@@ -115,7 +115,8 @@ def test_bad_linkage_range(good: Path, tmp_path: Path, rng) -> None:
 
 
 @pytest.mark.parametrize("extra,expect", [(("--seed", "-1"), "--seed must be 0 or more, got -1"),
-                                          (("--holdout", "1"), "--holdout must be in [0, 1)")])
+                                          (("--holdout", "1"), "--holdout must be in [0, 1)"),
+                                          (("--jobs", "0"), "--jobs must be at least 1, got 0")])
 def test_bad_option_value_is_one_line_exit_1(good: Path, tmp_path: Path, extra, expect) -> None:
     out = tmp_path / "report"
     r = odo_gap("diagnose", "--real", str(good), "--robot", LABMATE, "--out", str(out), "--quiet",

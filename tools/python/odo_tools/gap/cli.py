@@ -102,6 +102,13 @@ def main(argv: list[str] | None = None) -> int:
         help="write into a non-empty OUT odo-gap did not write (same-named files replaced, "
         "nothing removed)",
     )
+    d.add_argument(
+        "--jobs",
+        type=int,
+        default=None,
+        help="processes for the independent fits (default: every available core; the report "
+        "is the same with any number)",
+    )
     d.add_argument("--quiet", action="store_true", help="no progress output")
     b = sub.add_parser(
         "blind",
@@ -144,6 +151,8 @@ def main(argv: list[str] | None = None) -> int:
                 raise _Usage(f"--holdout must be in [0, 1), got {a.holdout:g}")
             if a.seed < 0:
                 raise _Usage(f"--seed must be 0 or more, got {a.seed}")
+            if a.jobs is not None and a.jobs < 1:
+                raise _Usage(f"--jobs must be at least 1, got {a.jobs}")
             acc = None
             if a.return_accuracy is not None:
                 try:
@@ -168,6 +177,7 @@ def main(argv: list[str] | None = None) -> int:
                 fit=a.fit,
                 judge_runs=a.judge,
                 groups=a.group,
+                jobs=a.jobs,
             )
             write_report(rep, a.out, a.force, [*a.real, a.robot])
             v = rep.verdict

@@ -19,6 +19,7 @@ Three steps, each its own function:
 
 from __future__ import annotations
 
+import functools
 import itertools
 import math
 import time
@@ -30,7 +31,7 @@ from typing import NamedTuple
 import numpy as np
 from threadpoolctl import threadpool_limits
 
-from . import catalog, hypotheses, instrument
+from . import catalog, hypotheses, instrument, par
 from .background import Background, measure
 from .bumps import clear_bumps, cluster_bumps, detect_bumps
 from .errors import GapInputError
@@ -218,12 +219,17 @@ def _lever_with_skid(ds: Dataset, keys: list[str], best: _Levers) -> _Levers:
     # behind its axle, for a skid: dev 2761 case 44); by quasi-BIC, as plain BIC took a skid on
     # a set with slip, 21 below 36 000, and moved its marker 6 mm (2721 case 45,
     # tests/python/test_gap_slip_motor.py)
-    cost = qbic(best, dev, n)
-    for m in range(1, 1 << len(each)):
+    def reading(m: int) -> tuple[_Levers, float, int]:
         r = _lever_rounds(ds, keys + [k for i, k in enumerate(each) if m >> i & 1])
         dev, _, n = deviance(r)
+        return r._replace(items=None), dev, n  # the items are rebuilt from r.inst (par.each)
+
+    cost = qbic(best, dev, n)
+    for r, dev, n in par.each([functools.partial(reading, m) for m in range(1, 1 << len(each))]):
         if (c := qbic(r, dev, n)) < cost:
             best, cost = r, c
+    if best.items is None:
+        best = best._replace(items=[TruthMode(pr, ds.robot, best.inst) for pr in ds.prs])
     return best
 
 
@@ -380,11 +386,11 @@ def rank(ds: Dataset, sel: Selection, progress: Progress = None) -> Ranking:
         # was "unexplained" at 11.6 x the background (2841 case 58; a set's, 2841 case 19: 133 x)
         geo = [h for h in hyps if len(h.laws) == 1 and h.families[0] in THIRDS]
         hyps += [v for v in (hypotheses.on_truck(h, t) for t in "AB" for h in geo) if v is not None]
-    singles = []
-    for h in hyps:
-        if progress:
-            progress(f"fitting {h.name}")
-        singles.append(fit_hypothesis(h, prob, fprs, sig_head))
+    singles = par.each(
+        [functools.partial(fit_hypothesis, h, prob, fprs, sig_head) for h in hyps],
+        [f"fitting {h.name}" for h in hyps],
+        progress,
+    )
     singles = [f for f in singles if _real(f)]
     singles.sort(key=lambda f: f.bic)
     detected = _bumps_under_best(singles, prob, fprs, sig_head)  # bumps: a truth-mode hypothesis
@@ -597,6 +603,14 @@ def _track_fit(hyp: hypotheses.Hypothesis, tp: TrackProblem, prob: Problem, warm
     return evaluate(prob, hyp.name, P, se, len(keys), hyp=hyp)
 
 
+def _track_member(
+    best: Fit, law: hypotheses.Law, tp: TrackProblem, prob: Problem, warm: dict
+) -> tuple[float, Fit]:
+    """(track ratio, fit) of `best` with `law` joined, fitted to the accumulated track."""
+    g = _track_fit(best.hyp + hypotheses.Hypothesis((law,)), tp, prob, warm)
+    return tp.ratio(g.model_params()), g
+
+
 def _track_prune(
     best: Fit, rbest: float, tp: TrackProblem, prob: Problem, warm: dict
 ) -> tuple[Fit, float]:
@@ -713,28 +727,25 @@ def _track_refit(ds: Dataset, sel: Selection, rk: Ranking, progress: Progress = 
     for fam in ("eb", "ed"):
         if fam in fams:
             singles += hypotheses.other_laws(fam, "truth", ds.robot.vehicle)
-    fits = []
-    for h in singles:
-        if progress:
-            progress(f"fitting {h.name} to the accumulated track")
-        g = _track_fit(h, tp, rk.prob, warm)
-        if _real(g):
-            fits.append(g)
+    fits = par.each(
+        [functools.partial(_track_fit, h, tp, rk.prob, warm) for h in singles],
+        [f"fitting {h.name} to the accumulated track" for h in singles],
+        progress,
+    )
+    fits = [g for g in fits if _real(g)]
     if not fits:
         return False
     best, rbest = _track_simplest(fits, [tp.ratio(f.model_params()) for f in fits])
     # greedy: a further geometry member joins while the tracks are beyond R_WITHIN and it at
     # least halves what is left above the background (the OptiOdom robot wants Ed, Eb and a scrub)
     while rbest > R_WITHIN and len(best.hyp.laws) < len(THIRDS):
-        tried = []
-        for f in fams:
-            if f in best.hyp.families:
-                continue
-            if progress:
-                progress(f"fitting {best.name}+{f} to the accumulated track")
-            w = {**warm, **best.model_params()}
-            g = _track_fit(best.hyp + hypotheses.Hypothesis((laws[f],)), tp, rk.prob, w)
-            tried.append((tp.ratio(g.model_params()), g))
+        more = [f for f in fams if f not in best.hyp.families]
+        w = {**warm, **best.model_params()}
+        tried = par.each(
+            [functools.partial(_track_member, best, laws[f], tp, rk.prob, w) for f in more],
+            [f"fitting {best.name}+{f} to the accumulated track" for f in more],
+            progress,
+        )
         if not tried:
             break
         r, g = min(tried, key=lambda x: x[0])
@@ -944,18 +955,21 @@ def _pairs(
     pairs = list(itertools.combinations(top, 2))
     absorbers = [f for f in singles if f.hyp.families[0] in ABSORBERS]
     pairs += [(a, b) for a in absorbers for b in top]
-    out = []
-    for a, b in pairs:
+
+    def pair(a: Fit, b: Fit) -> tuple[Fit, hypotheses.Hypothesis | None, list | None]:
         h = a.hyp + b.hyp
-        if progress:
-            progress(f"fitting {h.name}")
-        fb = None
-        if h.has_bumps:
-            other = a if not a.hyp.has_bumps else b
-            fb = bumps_for(other)
+        fb = bumps_for(a if not a.hyp.has_bumps else b) if h.has_bumps else None
         f = fit_hypothesis(h, prob, fprs, sig_head, fb, _warm(singles, {a.name, b.name}))
-        twin = None if _real(f) else _as_catalog(f, vehicle)
-        if twin is not None and twin.name not in {x.name for x in out} | {h.name}:
+        return f, None if _real(f) else _as_catalog(f, vehicle), fb
+
+    got = par.each(
+        [functools.partial(pair, a, b) for a, b in pairs],
+        [f"fitting {(a.hyp + b.hyp).name}" for a, b in pairs],
+        progress,
+    )
+    out = []
+    for f, twin, fb in got:
+        if twin is not None and twin.name not in {x.name for x in out} | {f.name}:
             # the load law's zeta went to zero beside its partner: the pair is the catalog
             # law's (simulator seed 2742 case 33: Eb's load law led the singles, so eb + ed was
             # never formed, and eb@load + ed with zeta 0 is no candidate - roughness won)
@@ -984,21 +998,28 @@ def _as_catalog(f: Fit, vehicle: str) -> hypotheses.Hypothesis | None:
 def _third(pair: Fit, singles, prob, fprs, sig_head, progress) -> list[Fit]:
     """A third member for an accepted pair (the kinematic calibration of a real robot is often
     three: Ed, Eb and a scrub), from the best kinematic singles of other families."""
-    out = []
-    n = 0
-    for f in singles:
-        if set(f.hyp.families) & set(pair.hyp.families) or f.hyp.families[0] not in THIRDS:
-            continue
-        h = pair.hyp + f.hyp
-        if progress:
-            progress(f"fitting {h.name}")
-        warm = dict(pair.model_params())
-        warm.update(f.model_params())
-        fb = pair.bumps if pair.hyp.has_bumps else None
-        out.append(fit_hypothesis(h, prob, fprs, sig_head, fb, warm))
-        n += 1
-        if n == N_THIRD:
-            break
+    thirds = [
+        f
+        for f in singles
+        if not set(f.hyp.families) & set(pair.hyp.families) and f.hyp.families[0] in THIRDS
+    ][:N_THIRD]
+    fb = pair.bumps if pair.hyp.has_bumps else None
+    out = par.each(
+        [
+            functools.partial(
+                fit_hypothesis,
+                pair.hyp + f.hyp,
+                prob,
+                fprs,
+                sig_head,
+                fb,
+                {**pair.model_params(), **f.model_params()},
+            )
+            for f in thirds
+        ],
+        [f"fitting {(pair.hyp + f.hyp).name}" for f in thirds],
+        progress,
+    )
     return [f for f in out if _real(f)]
 
 
@@ -1209,10 +1230,14 @@ def _slip_not_latency(
             h for h in hypotheses.singles("truth", ds.robot.vehicle) if h.name == "slip"
         )
 
-    def under_clock(L: float, held: list | None = None) -> tuple[Fit, Instrument, list, float]:
+    def clock(L: float) -> tuple[Instrument, list]:
         inst = ds.instrument.copy()
         inst.latency_s = {k: L for k in ds.instrument.latency_s}
-        items = [TruthMode(pr, ds.robot, inst) for pr in ds.prs]
+        return inst, [TruthMode(pr, ds.robot, inst) for pr in ds.prs]
+
+    def cost(L: float, held: list | None = None) -> float:
+        """BIC of the candidate with every run's truth `L` late."""
+        items = clock(L)[1]
         prob = Problem("truth", [items[i] for i in sel.fit], ranked.sigma)
         prob.set_background(ranked.walk, ranked.sigma)
         f = fit_hypothesis(
@@ -1224,7 +1249,11 @@ def _slip_not_latency(
             warm=ask.model_params(),
         )
         # a clock other than none is one parameter
-        return f, inst, items, f.bic + (math.log(max(f.n, 2)) if L else 0.0)
+        return f.bic + (math.log(max(f.n, 2)) if L else 0.0)
+
+    def scan(clocks: tuple[float, ...]) -> dict[float, float]:
+        got = par.each([functools.partial(cost, L, held) for L in clocks])
+        return dict(zip(clocks, got, strict=True))
 
     # the clock is looked for once (each point a fit); asked again (after the ranking, with
     # the best candidate), only whether the latencies are the slip. A candidate with bumps
@@ -1234,17 +1263,14 @@ def _slip_not_latency(
     held = ask.bumps if hyp.has_bumps and ask.bumps else None
     grid = (0.0,) if ds.instrument.clock_scanned else SLIP_CLOCK_S
     ds.instrument.clock_scanned = True
-    tried = {L: under_clock(L, held) for L in grid}
-    top = min(tried, key=lambda L: tried[L][3])
+    tried = scan(grid)
+    top = min(tried, key=lambda L: tried[L])
     if top:
-        for L in (top - SLIP_CLOCK_REFINE_S, top + SLIP_CLOCK_REFINE_S):
-            tried[L] = under_clock(L, held)
-        top = min(tried, key=lambda L: tried[L][3])
-    _, inst, items, cost = under_clock(top) if held else tried[top]
-    if cost >= best.bic - len(lat) * math.log(max(best.n, 2)):
+        tried.update(scan((top - SLIP_CLOCK_REFINE_S, top + SLIP_CLOCK_REFINE_S)))
+        top = min(tried, key=lambda L: tried[L])
+    if (cost(top) if held else tried[top]) >= best.bic - len(lat) * math.log(max(best.n, 2)):
         return False
-    ds.instrument = inst
-    ds.items = items
+    ds.instrument, ds.items = clock(top)
     return True
 
 
@@ -1259,12 +1285,14 @@ def diagnose(
     fit: list[str] | None = None,
     judge_runs: list[str] | None = None,
     groups: list[str] | None = None,
+    jobs: int | None = None,
 ) -> Report:
-    """Diagnose the runs in `real` (a folder or a list of folders; module doc)."""
+    """Diagnose the runs in `real` (a folder or a list of folders; module doc). `jobs`: worker
+    processes for the independent fits (None: every available core; the result is the same)."""
     # one BLAS thread: the fits' matrices are small, and a second thread per process made a
     # diagnosis slower alone (26 s against 21 s) and oversubscribed the cores when the blind
     # check runs two diagnoses side by side (36.5 s)
-    with threadpool_limits(limits=1, user_api="blas"):
+    with threadpool_limits(limits=1, user_api="blas"), par.cores(jobs):
         return _diagnose(
             real,
             robot_path,

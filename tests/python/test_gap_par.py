@@ -1,0 +1,110 @@
+"""A diagnosis's independent fits on several cores (gap/par.py): the same result as on one,
+bit for bit, with the work really done in other processes."""
+
+from __future__ import annotations
+
+import json
+import multiprocessing
+import os
+
+import numpy as np
+import pytest
+from gap_support import BUILD, SRC, indep_case
+
+TWO = len(os.sched_getaffinity(0)) >= 2
+
+
+@pytest.fixture(autouse=True)
+def _env(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("ODO_BUILD_DIR", str(BUILD))
+    monkeypatch.setenv("ODO_SOURCE_DIR", str(SRC))
+
+
+def _task(i: int) -> tuple[int, int]:
+    return i * i, os.getpid()
+
+
+@pytest.mark.skipif(not TWO, reason="one core: nothing runs beside the parent")
+def test_each_keeps_the_order_and_runs_in_workers() -> None:
+    from functools import partial
+
+    from odo_tools.gap import par
+
+    tasks = [partial(_task, i) for i in range(7)]
+    labels = [f"task {i}" for i in range(7)]
+    for jobs, elsewhere in ((1, False), (2, True)):
+        seen: list[str] = []
+        with par.cores(jobs):
+            got = par.each(tasks, labels, seen.append)
+        assert [v for v, _ in got] == [i * i for i in range(7)]
+        assert seen == labels
+        assert any(pid != os.getpid() for _, pid in got) is elsewhere
+    assert par._jobs == 1  # the context put it back
+
+
+def _in_pool_worker(_: int) -> tuple[int, list[int]]:
+    from functools import partial
+
+    from odo_tools.gap import par
+
+    with par.cores(None) as n:
+        got = par.each([partial(_task, i) for i in range(3)])
+    return n, [pid for _, pid in got]
+
+
+def test_a_pool_worker_runs_its_batches_itself() -> None:
+    """The blind check diagnoses in pool workers, which are daemonic and may not have
+    children: there a batch runs in the worker, serially."""
+    with multiprocessing.get_context("fork").Pool(1) as pool:
+        n, pids = pool.map(_in_pool_worker, [0])[0]
+    assert n == 1
+    assert len(set(pids)) == 1 and pids[0] != os.getpid()
+
+
+def _report(real, jobs: int) -> str:
+    from odo_tools.gap.diagnose import diagnose
+
+    d = diagnose(real, real / "robot.json", mode="truth", jobs=jobs).to_dict()
+    d.pop("elapsed_s", None)
+    return json.dumps(d, sort_keys=True, default=str)
+
+
+@pytest.mark.skipif(not TWO, reason="one core: nothing runs beside the parent")
+def test_diagnosis_is_the_same_on_one_core_and_two(tmp_path) -> None:
+    """A LabMate with traction slip whose truth runs late (independent world, dev seed 2701
+    case 21): its diagnosis fits singles and pairs, scans the clock, and ranks again - every
+    batch that runs in workers."""
+    real = tmp_path / "real"
+    indep_case(2701, 21, real, "labmate", {"slip": "traction"})
+    one, two = _report(real, 1), _report(real, 2)
+    assert json.loads(one)["verdict"]["effect"] == "slip"
+    assert one == two
+
+
+@pytest.mark.skipif(not TWO, reason="one core: nothing runs beside the parent")
+def test_lever_arms_under_skid_subsets_are_the_same_on_two_cores(tmp_path) -> None:
+    """The lever arms read under each subset of skidding trucks (a clapper with a skid on truck
+    A and truck B's marker 25 mm behind its axle, dev seed 2761 case 44): the winner's items
+    are rebuilt in the parent from its instrument, and must be the ones that instrument gives,
+    on one core or two."""
+    from odo_tools.gap import diagnose as D
+    from odo_tools.gap import par
+    from odo_tools.gap.modes import TruthMode
+
+    real = tmp_path / "real"
+    indep_case(2761, 44, real, "clapper", {"skid": "cornering"})
+    got = []
+    for jobs in (1, 2):
+        with par.cores(jobs):
+            ds = D.load(real, real / "robot.json")
+        got.append(ds)
+    a, b = got
+    assert any("cornering skid" in n for n in a.notes)
+    assert np.hypot(*a.instrument.lever_mm[1]) > 10.0  # the rebuilt items carry it
+    assert a.notes == b.notes
+    assert a.instrument.lever_mm == b.instrument.lever_mm
+    assert a.instrument.latency_s == b.instrument.latency_s
+    for pr, x, y in zip(b.prs, a.items, b.items, strict=True):
+        want = TruthMode(pr, b.robot, b.instrument).residuals({})  # under the arms found
+        assert np.array_equal(x.residuals({}), want)
+        assert np.array_equal(y.residuals({}), want)
