@@ -115,6 +115,22 @@ def test_traction_slip_on_arcs_is_not_read_as_truth_latency(tmp_path: Path) -> N
     assert max(abs(v) for v in rep["instrument"]["latency_s"].values()) < 0.05
 
 
+def test_a_clock_no_run_fixed_is_found_under_slip_and_kept(tmp_path: Path) -> None:
+    """Independent world, dev seed 2851 case 25: a set with no effect whose truth runs 14.8 ms
+    late on 50 ms ticks, too little for any run's track to fix. With no latency, the slip laws
+    took the shift (slip@accel 201 BIC above nominal) and the verdict was "unexplained" at
+    2.44 x the background. The one clock is now scanned under slip, 15 ms is found, and the
+    judge keeps it for the runs whose tracks fix none: no significant gap."""
+    from odo_tools.gap.diagnose import diagnose
+
+    real = tmp_path / "real"
+    c = indep_case(2851, 25, real, "set", {})
+    rep = diagnose(real, real / "robot.json", mode="truth").to_dict()
+    assert rep["verdict"]["effect"] == "no significant gap", rep["verdict"]
+    true = c["fidelity"]["truth_latency_s"]
+    assert all(abs(v - true) < 0.005 for v in rep["instrument"]["latency_s"].values())
+
+
 def test_slip_read_as_latency_is_told_apart_before_the_pairs(tmp_path: Path) -> None:
     """Simulator world, seed 2712 case 28: a clapper with catalog slip (k 0.98 per m/s^2) and a
     truth without latency, whose starts read as 97 ms on four runs. With slip among the top

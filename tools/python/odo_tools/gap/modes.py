@@ -184,12 +184,14 @@ class Instrument:
     heading_offset_se_rad: list[float] = field(default_factory=lambda: [0.0, 0.0])
     # one clock for every run was looked for under a slip candidate (diagnose._slip_not_latency)
     clock_scanned: bool = False
+    # the one clock that scan gave every run (s), None where it kept the runs' own
+    clock_s: float | None = None
 
     def copy(self) -> Instrument:
         return Instrument(
             list(self.lever_mm), list(self.lever_se_mm), dict(self.latency_s),
             list(self.heading_offset_rad), list(self.heading_offset_se_rad),
-            self.clock_scanned,
+            self.clock_scanned, self.clock_s,
         )  # fmt: skip
 
 
