@@ -230,16 +230,34 @@ def test_track_simplest(ratios: tuple, chosen: str) -> None:
     assert best.name == chosen and r == ratios[[f.name for f in fits].index(chosen)]
 
 
-def test_a_member_the_tracks_do_not_need_leaves_the_pair(tmp_path: Path) -> None:
+def test_a_member_the_tracks_do_not_need_leaves_the_pair(tmp_path, monkeypatch) -> None:
     """Independent world, dev seed 2761 case 28: a set whose trailer's wheels differ (Ed
-    0.99846 on truck B). The windows ranked a motor-law slip first and took "ed + slip" from it
-    (Delta qBIC -0.1, accepted on the tracks: 13.1 -> 4.9 x the background). Without the slip
-    the tracks stay where they were, so it leaves (diagnose._prune_members) and the verdict is
-    the trailer's Ed."""
+    0.99846 on truck B) and whose truth runs 6.7 ms late on 10 ms ticks, which no run's track
+    fixes. With no clock, the windows ranked a motor-law slip first and took "ed + slip" from
+    it (Delta qBIC -0.1, accepted on the tracks: 13.1 -> 4.9 x the background). Without the
+    slip the tracks stay where they were, so it leaves (diagnose._prune_members) and the
+    verdict is the trailer's Ed. Since the clock is scanned where no run fixed one (10 ms
+    found), the trailer's Ed leads alone and nothing needs to leave; the pruning is asked
+    here with the clock left unscanned, as it was."""
     real = tmp_path / "real"
     indep_case(2761, 28, real, "set", {"ed": "fixed"})
-    rep = D.diagnose(real, real / "robot.json", mode="truth").to_dict()
-    v = rep["verdict"]
-    assert v["effect"] == "ed", v
-    assert v["params"]["ed.value.B"] == pytest.approx(0.99846, abs=3e-4)
+
+    def diagnosed() -> dict:
+        rep = D.diagnose(real, real / "robot.json", mode="truth").to_dict()
+        assert rep["verdict"]["effect"] == "ed", rep["verdict"]
+        assert rep["verdict"]["params"]["ed.value.B"] == pytest.approx(0.99846, abs=3e-4)
+        return rep
+
+    rep = diagnosed()
+    assert set(rep["instrument"]["latency_s"].values()) == {0.01}
+    assert "the accumulated track" not in rep["proposals"]
+    ask = D._slip_not_latency
+
+    def no_scan(ds, sel, ranked, best, cand=None) -> bool:
+        late = [i for i in sel.fit if ds.instrument.latency_s.get(ds.prs[i].run.name)]
+        return bool(late) and ask(ds, sel, ranked, best, cand)
+
+    monkeypatch.setattr(D, "_slip_not_latency", no_scan)
+    rep = diagnosed()
+    assert set(rep["instrument"]["latency_s"].values()) == {0.0}
     assert "the rest is not needed there" in rep["proposals"]["the accumulated track"]
