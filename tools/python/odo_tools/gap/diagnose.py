@@ -1235,22 +1235,22 @@ def _slip_not_latency(
             h for h in hypotheses.singles("truth", ds.robot.vehicle) if h.name == "slip"
         )
 
-    def clock(L: float) -> tuple[Instrument, list]:
+    def clock(L: float) -> Instrument:
         inst = ds.instrument.copy()
         inst.latency_s = {k: L for k in ds.instrument.latency_s}
         inst.clock_s = L
-        return inst, [TruthMode(pr, ds.robot, inst) for pr in ds.prs]
+        return inst
 
     def cost(L: float, held: list | None = None) -> float:
-        """BIC of the candidate with every run's truth `L` late."""
-        items = clock(L)[1]
-        prob = Problem("truth", [items[i] for i in sel.fit], ranked.sigma)
+        """BIC of the candidate with every run's truth `L` late (the fitting runs only)."""
+        inst = clock(L)
+        prob = Problem("truth", [TruthMode(pr, ds.robot, inst) for pr in fprs], ranked.sigma)
         prob.set_background(ranked.walk, ranked.sigma)
         f = fit_hypothesis(
             hyp,
             prob,
             fprs,
-            _sig_head(prob, items[0].channels()),
+            _sig_head(prob, prob.items[0].channels()),
             floor_bumps=held,
             warm=ask.model_params(),
         )
@@ -1276,7 +1276,8 @@ def _slip_not_latency(
         top = min(tried, key=lambda L: tried[L])
     if (cost(top) if held else tried[top]) >= best.bic - len(lat) * math.log(max(best.n, 2)):
         return False
-    ds.instrument, ds.items = clock(top)
+    ds.instrument = clock(top)
+    ds.items = [TruthMode(pr, ds.robot, ds.instrument) for pr in ds.prs]
     return True
 
 

@@ -191,8 +191,7 @@ def under(inst: Instrument, prs: list[Prepared], P: dict) -> Instrument:
     }
     # a run whose track does not fix its shift keeps the clock the scan found under slip
     # (diagnose._slip_not_latency), rather than none
-    keep = {k: out.clock_s for k in out.latency_s} if out.clock_s is not None else None
-    out.latency_s.update(session_latencies(with_truth, found, keep))
+    out.latency_s.update(session_latencies(with_truth, found, out.clock_s or 0.0))
     return out
 
 
@@ -335,7 +334,7 @@ CLOCK_TICKS = 1.5  # a latency this many ticks long is the rig's, whatever the s
 
 
 def session_latencies(
-    prs: list[Prepared], found: dict[str, float | None], known: dict[str, float] | None = None
+    prs: list[Prepared], found: dict[str, float | None], unfixed: float = 0.0
 ) -> dict[str, float]:
     """A run whose track does not fix its latency (a spin, a run an effect dominates) takes the
     median of its session's runs that do: the clock offset is the rig's (the independent
@@ -344,8 +343,7 @@ def session_latencies(
     agrees with that clock and gives the clock to the few that do not (tried: the clock for
     every run, which moved as many verdicts of the independent world one way as the other). A
     session whose runs disagree keeps each run's own shift, but only where it is too long for
-    an effect to fake. `known`: a run's latency where no run of its session fixes one (else
-    none)."""
+    an effect to fake. `unfixed`: the latency where no run of a session fixes one."""
     out = {}
     for pr in prs:
         name = pr.run.name
@@ -354,7 +352,7 @@ def session_latencies(
             continue
         same = [found[p.run.name] for p in prs if p.run.session == pr.run.session]
         valid = [x for x in same if x is not None]
-        out[name] = float(np.median(valid)) if valid else (known or {}).get(name, 0.0)
+        out[name] = float(np.median(valid)) if valid else unfixed
     tick = _tick(prs)
     by: dict[str, list[Prepared]] = {}
     for pr in prs:
