@@ -88,6 +88,7 @@ class Dataset:
     instrument: Instrument | None = None
     notes: list[str] = field(default_factory=list)
     noise_dof: float | None = None  # returns without a stated accuracy: dof of the spread
+    clock: instrument.ClockRate | None = None  # truth mode: the truth clock's rate (judge)
 
 
 def pick_mode(runs: list[RunData], vehicle: str, want: str | None, real) -> str:
@@ -1054,6 +1055,9 @@ def judge(ds: Dataset, sel: Selection, rk: Ranking) -> Judgement:
     if ds.noise_dof is not None:
         held.extra["noise_dof"] = ds.noise_dof
     dbic = rk.null.bic - rk.best.bic
+    if ds.mode == "truth" and ds.instrument is not None:
+        # under the best candidate, as the latencies above: an Es read -420 ppm on the nominal
+        ds.clock = instrument.clock_rate(ds.prs, ds.instrument, rk.best.model_params())
     verdict, reason = decide(held, dbic, rk.best.label, weak_gap=ds.mode == "truth")
     return Judgement(verdict, reason, bg, held, dbic)
 
@@ -1346,6 +1350,17 @@ def _diagnose(
         jd.reason = (
             f"{jd.verdict} fits the held-out runs ({jd.held.ratio_before:.2f} -> "
             f"{jd.held.ratio_after:.2f} x the background), but its {moved.text}"
+        )
+        jd.verdict = "unexplained"
+        named = False
+    if ds.clock is not None and ds.clock.drifting():
+        c = ds.clock
+        jd.reason = (
+            f"the truth's clock runs {c.ppm:+.0f} +- {c.se_ppm:.0f} ppm against the wheel counts "
+            f"({c.runs} of {c.of} runs agree; each run's latency grows "
+            f"{c.ppm * 1e-3 * c.span_s:+.0f} ms from its start to its end), which no robot "
+            f"effect models (best candidate {rk.best.label}, {jd.held.ratio_before:.2f} -> "
+            f"{jd.held.ratio_after:.2f} x the background): re-stamp the truth and diagnose again"
         )
         jd.verdict = "unexplained"
         named = False

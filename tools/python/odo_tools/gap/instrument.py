@@ -24,6 +24,7 @@ misfit follows the turn rate), the squares ~25 ms; the lever arm of its marker i
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -425,3 +426,61 @@ def lever_arm(
     cov = np.linalg.pinv((A * w[:, None]).T @ (A * w[:, None])) * s2
     se = (float(math.sqrt(max(cov[0, 0], 0.0))), float(math.sqrt(max(cov[1, 1], 0.0))))
     return (float(o[0]), float(o[1])), se, n
+
+
+CLOCK_RATE_MIN_PPM = 200.0  # a truth clock drifting less than this is left alone
+CLOCK_RATE_Z = 8.0  # the runs' median rate in standard errors of it (their scatter / sqrt(n))
+CLOCK_RATE_RUNS = 2.0 / 3.0  # the share of the truth runs whose both thirds fix a latency
+CLOCK_RATE_MIN_RUNS = 4
+
+
+@dataclass
+class ClockRate:
+    """How fast the truth's clock runs against the wheel counts' within a run (ppm: each run's
+    latency grows by ppm x 1e-6 per second of the run), from the runs' latencies on their first
+    and last thirds; `runs` of `of` truth runs fixed both."""
+
+    ppm: float
+    se_ppm: float
+    runs: int
+    of: int
+    span_s: float  # the median run's duration
+
+    def drifting(self) -> bool:
+        return (
+            self.runs >= max(CLOCK_RATE_MIN_RUNS, CLOCK_RATE_RUNS * self.of)
+            and abs(self.ppm) >= CLOCK_RATE_MIN_PPM
+            and abs(self.ppm) >= CLOCK_RATE_Z * self.se_ppm
+        )
+
+
+def clock_rate(prs: list[Prepared], inst: Instrument, P: dict | None = None) -> ClockRate | None:
+    """The truth clock's rate against the counts (ClockRate), None without four runs that fix
+    it. A clock that drifts shifts a run's latency linearly over the run, which one latency
+    per run cannot follow; a robot effect moves a third's latency by the path it drives there,
+    not by the time, so the runs scatter instead of agreeing (under the candidate P: on the
+    nominal model an Es read -420 ppm on seven runs, `tests/python/test_gap_clock.py`)."""
+    rates, spans = [], []
+    with_truth = [pr for pr in prs if pr.run.truth is not None]
+    for pr in with_truth:
+        tr = pr.run.truth
+        n = tr.t_s.size
+        spans.append(float(tr.t_s[-1] - tr.t_s[0]))
+        got = []
+        for a, b in ((0, n // 3), (n - n // 3, n)):
+            link = None if tr.link is None else tr.link[a:b]
+            third = replace(tr, t_s=tr.t_s[a:b], pose=tr.pose[a:b], link=link)
+            part = replace(pr, run=replace(pr.run, truth=third))
+            L = latency(
+                part, 0, P, lever=inst.lever_mm[0], heading_offset=inst.heading_offset_rad[0]
+            )
+            got.append((L, float(np.mean(tr.t_s[a:b]))))
+        (l0, t0), (l1, t1) = got
+        if l0 is not None and l1 is not None and t1 > t0:
+            rates.append((l1 - l0) / (t1 - t0) * 1e6)
+    if len(rates) < CLOCK_RATE_MIN_RUNS:
+        return None
+    r = np.array(rates)
+    med = float(np.median(r))
+    se = max(_mad(r), 1.0) / math.sqrt(r.size)
+    return ClockRate(med, se, int(r.size), len(with_truth), float(np.median(spans)))

@@ -196,6 +196,7 @@ class Report:
                     math.degrees(x) for x in ds.instrument.heading_offset_rad[: ds.robot.n_trucks]
                 ],
                 "notes": list(ds.notes),
+                "clock_rate": asdict(ds.clock) if ds.clock is not None else None,
             }
         bg = jd.background
         bgd: dict[str, Any] = {"mode": ds.mode}
@@ -409,7 +410,13 @@ def next_step(ds: Dataset, sel: Selection, verdict: str, best: Fit, findings: li
                 "JSON for odo-calib write",
             }.get(f, f"model {f}")
         )
-    if verdict == "unexplained":
+    if verdict == "unexplained" and ds.clock is not None and ds.clock.drifting():
+        out.append(
+            "stamp the truth with the robot's clock (or scale its time by "
+            f"{1.0 - ds.clock.ppm * 1e-6:.6f} from each run's start) and diagnose again: a "
+            "truth that drifts against the counts is compared with the wrong wheel counts"
+        )
+    elif verdict == "unexplained":
         out.append(
             "no catalog effect closes the gap: look at gap_along_path.png and the 'where' table "
             "for the phase that carries it, and record runs that isolate it"
@@ -560,6 +567,13 @@ def markdown(rep: dict) -> str:
             L.append(
                 f"- truth latency against the wheel counts: {min(lat) * 1e3:.0f} to "
                 f"{max(lat) * 1e3:.0f} ms per run (report.json instrument.latency_s)"
+            )
+        cr = inst.get("clock_rate")
+        if cr:
+            L.append(
+                f"- truth clock against the wheel counts: {cr['ppm']:+.0f} +- {cr['se_ppm']:.0f} "
+                f"ppm within a run ({cr['runs']} of {cr['of']} runs: latency on their first and "
+                "last thirds)"
             )
         L += [f"- {n}" for n in inst["notes"]]
     L += ["", "## Not identifiable from these data", ""]

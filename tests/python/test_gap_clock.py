@@ -1,0 +1,67 @@
+"""A truth clock that drifts against the wheel counts (issue 13 item 2, out of the catalog): each
+run's latency grows linearly from its start to its end, which one latency per run cannot
+follow. The runs' latencies on their first and last thirds give the rate (instrument.clock_rate,
+under the best candidate); runs that agree on it beyond instrument.CLOCK_RATE_Z standard errors
+make the verdict "unexplained", with the rate in the reason and the report."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+from gap_support import BUILD, SRC, indep_case
+
+
+@pytest.fixture(autouse=True)
+def _env(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("ODO_BUILD_DIR", str(BUILD))
+    monkeypatch.setenv("ODO_SOURCE_DIR", str(SRC))
+
+
+def test_a_drifting_truth_clock_is_unexplained_with_its_rate(tmp_path: Path) -> None:
+    """Independent world, seed 2911 case 31: a LabMate with no effect whose motion capture
+    drifts 847 ppm against its counts (43 ms over a 50 s run). The held-out runs sat below the
+    gap threshold (1.58 x the background) and the verdict was "no significant gap", which hid
+    a rig that cannot be trusted; the eight runs read 854 +- 14 ppm."""
+    from odo_tools.gap.diagnose import diagnose
+
+    real = tmp_path / "real"
+    c = indep_case(2911, 31, real, "labmate", {"clock_drift": "linear"})
+    rep = diagnose(real, real / "robot.json", mode="truth").to_dict()
+    true = c["true"]["effects"]["clock_drift"]["ppm"]
+    cr = rep["instrument"]["clock_rate"]
+    assert abs(cr["ppm"] - true) < 0.15 * abs(true), (cr, true)
+    assert rep["verdict"]["effect"] == "unexplained", rep["verdict"]
+    v, steps = rep["verdict"], rep["next_step"]
+    assert f"the truth's clock runs {cr['ppm']:+.0f} +- " in v["reason"], v
+    assert steps[0].startswith("stamp the truth with the robot's clock"), steps
+
+
+def test_an_es_reads_as_a_clock_on_the_nominal_model_only(tmp_path: Path) -> None:
+    """Independent world, dev seed 2811 case 25: a set's trailer with a mean-diameter error and a
+    truth clock that holds still. On the nominal model the runs' thirds read -420 ppm, seven of
+    seven agreeing; under the best candidate (Es) the rate is gone and the verdict stays es."""
+    from odo_tools.gap import diagnose as D
+    from odo_tools.gap import instrument
+
+    real = tmp_path / "real"
+    indep_case(2811, 25, real, "set", {"es": "deflection"})
+    ds = D.load(real, real / "robot.json", "truth")
+    nominal = instrument.clock_rate(ds.prs, ds.instrument)
+    assert nominal is not None and nominal.drifting(), nominal
+    rep = D.diagnose(real, real / "robot.json", mode="truth").to_dict()
+    assert rep["verdict"]["effect"] == "es", rep["verdict"]
+    cr = rep["instrument"]["clock_rate"]
+    assert abs(cr["ppm"]) < 0.25 * abs(nominal.ppm), (cr, nominal)
+
+
+def test_a_clock_needs_many_runs_that_agree_on_a_real_rate() -> None:
+    """Each rule of ClockRate.drifting bites on its own: the rate, its standard error, the share
+    of the runs whose thirds both fixed a latency, and their number."""
+    from odo_tools.gap.instrument import ClockRate
+
+    assert ClockRate(600.0, 30.0, 9, 10, 50.0).drifting()
+    assert not ClockRate(150.0, 5.0, 9, 10, 50.0).drifting()  # too slow to matter
+    assert not ClockRate(-600.0, 90.0, 9, 10, 50.0).drifting()  # the runs scatter
+    assert not ClockRate(600.0, 30.0, 6, 10, 50.0).drifting()  # too few of the runs
+    assert not ClockRate(600.0, 30.0, 3, 3, 50.0).drifting()  # too few runs
