@@ -61,6 +61,32 @@ def test_a_pool_worker_runs_its_batches_itself() -> None:
     assert len(set(pids)) == 1 and pids[0] != os.getpid()
 
 
+def _bad_input() -> None:
+    from odo_tools.gap.errors import GapInputError
+
+    raise GapInputError("runs/run-01.truth.csv", "time goes backwards", 17)
+
+
+@pytest.mark.skipif(not TWO, reason="one core: nothing runs beside the parent")
+def test_a_bad_input_raised_in_a_worker_reaches_the_caller() -> None:
+    """An input error raised in a worker comes back to the caller with its file and line. It
+    did not unpickle (its __init__ takes the file and the reason, not the message): the pool's
+    result thread died on it and the diagnosis waited for ever."""
+    import pickle
+
+    from odo_tools.gap import par
+    from odo_tools.gap.errors import GapInputError
+    from odo_tools.outpath import OutputError
+
+    for e in (GapInputError("a.csv", "bad", 3), OutputError("out", "not ours")):
+        back = pickle.loads(pickle.dumps(e))
+        assert (type(back), str(back), vars(back)) == (type(e), str(e), vars(e))
+    with par.cores(2), pytest.raises(GapInputError) as got:
+        par.each([_bad_input, _bad_input])
+    assert str(got.value) == "runs/run-01.truth.csv:17: time goes backwards"
+    assert (got.value.path, got.value.line) == ("runs/run-01.truth.csv", 17)
+
+
 def _report(real, jobs: int) -> str:
     from odo_tools.gap.diagnose import diagnose
 

@@ -44,6 +44,9 @@ class OutputError(Exception):
         self.why = why
         super().__init__(f"{self.path}: {why}")
 
+    def __reduce__(self):
+        return type(self), (self.path, self.why)  # rebuilt from its arguments (errors.py)
+
 
 def _cleanup() -> None:
     for p in sorted(_TEMPS, key=lambda q: len(q.parts), reverse=True):

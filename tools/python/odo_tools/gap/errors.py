@@ -14,3 +14,8 @@ class GapInputError(Exception):
         self.why = why
         where = f"{self.path}:{line}" if line is not None else self.path
         super().__init__(f"{where}: {why}")
+
+    def __reduce__(self):
+        # pickled by its own arguments: one raised in a worker process (gap/par.py) must rebuild
+        # in the parent, whose pool thread otherwise fails on it and the diagnosis waits for ever
+        return type(self), (self.path, self.why, self.line)
