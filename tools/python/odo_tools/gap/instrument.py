@@ -17,6 +17,11 @@ per run). Both move the truth in ways no catalog effect should be asked to expla
   accelerates (the simulator's slip read 12 ms on UMBmark and 25 ms on rect-7x4); a clock
   offset is the same on every run (the independent world's 22-25 ms).
 
+- **Clock rate** (`clock_rate`, after ranking): a truth clock that runs at another rate than
+  the robot's moves each run's latency linearly over the run; measured from the latencies of
+  each run's first and last thirds under the best candidate, and, where the runs agree on it,
+  it makes the verdict "unexplained" (diagnose._diagnose).
+
 The OptiOdom circles carry ~0.1-0.3 s of latency between mocap and wheel counts (their heading
 misfit follows the turn rate), the squares ~25 ms; the lever arm of its marker is ~1-2 cm.
 """
