@@ -252,7 +252,7 @@ def test_one_trucks_geometry_is_fitted_to_the_tracks_on_that_truck(tmp_path: Pat
     nothing of it (Delta BIC 6); the tracks of B drift 2-4 deg along a 17 m run. Fitted to the
     tracks on both trucks at once, no geometry came near (an Ed's growth law left 6.6 x, since
     truck A has none), and the verdict was "unexplained" at 39 x the background. The track fit
-    now tries each truck's own geometry too."""
+    now tries the own geometry of the truck whose tracks sit furthest off (here B)."""
     c, rep = indep_named(2841, 23, tmp_path, "clapper", {"ed": "speed"}, "ed", "growth")
     v = rep["verdict"]
     assert set(v["params"]) == {"ed.value.B", "ed@growth.g_per_m2_s2.B"}, v["params"]

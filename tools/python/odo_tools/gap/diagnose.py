@@ -751,8 +751,8 @@ def _track_refit(ds: Dataset, sel: Selection, rk: Ranking, progress: Progress = 
     # ... and on a clapper or set the own geometry of the truck whose tracks sit furthest off:
     # one truck's tyre growing with speed drifted truck B's tracks 2-4 deg, which no law on both
     # trucks came near (independent world, dev seed 2841 case 23: "unexplained" at 39 x, Ed's
-    # growth law on B 1.9 x). Both trucks' variants cost 15 % more time on the dev clappers and
-    # sets (the slowest 36.6 -> 54.8 s) for the same verdicts
+    # growth law on B 1.9 x). Both trucks' variants gave the same verdicts on the 97 dev
+    # clappers and sets of 2821-2851 with twice the added fits
     if ds.robot.n_trucks == 2:
         t = tp.excess_truck({})
         singles += [v for v in (hypotheses.on_truck(h, t) for h in singles) if v]
