@@ -48,10 +48,18 @@ from .fit import (
 )
 from .heldout import HELDOUT_BUMP_MIN_RUNS, HeldOut, apply, track_error, track_z, tracked
 from .heldout import evaluate as evaluate_heldout
-from .io import Robot, RunData, discover_all, read_robot
+from .io import Robot, RunData, discover_all, halves, read_robot
 from .model import Prepared, prepare, skipped_evidence
 from .modes import MODES, Instrument, TruthMode
-from .paths import assign_paths, assign_shapes, group_key, motion_kind
+from .paths import (
+    HALF_MIN_S,
+    assign_paths,
+    assign_shapes,
+    cut_tick,
+    group_key,
+    lone_kinds,
+    motion_kind,
+)
 from .report import Context, Report
 from .select import Selection, explicit, parse_groups, stratified
 from .stability import analyse as stability
@@ -89,6 +97,7 @@ class Dataset:
     notes: list[str] = field(default_factory=list)
     noise_dof: float | None = None  # returns without a stated accuracy: dof of the spread
     clock: instrument.ClockRate | None = None  # truth mode: the truth clock's rate (judge)
+    halved: list[str] = field(default_factory=list)  # runs cut in two (load's `halve`)
 
 
 def pick_mode(runs: list[RunData], vehicle: str, want: str | None, real) -> str:
@@ -122,8 +131,11 @@ def load(
     mode: str | None = None,
     return_accuracy: tuple[float, float] | None = None,
     group_specs: list[str] | None = None,
+    halve: bool = False,
 ) -> Dataset:
-    """Step 1: read and check everything (GapInputError on anything bad; nothing is written)."""
+    """Step 1: read and check everything (GapInputError on anything bad; nothing is written).
+    `halve` (truth mode, for a random split): a run that is its kind of motion's only one is cut
+    in two (paths.lone_kinds), so that the split can fit one half and judge the other."""
     robot = read_robot(robot_path)
     folders = [Path(p) for p in (real if isinstance(real, (list, tuple)) else [real])]
     runs = discover_all(folders, robot)
@@ -134,9 +146,15 @@ def load(
     if return_accuracy is None:
         return_accuracy = recorded_accuracy(folders)
     prs = [prepare(r, robot) for r in runs]
+    halved = []
+    if halve and mode == "truth":
+        runs, prs, halved = _halve_lone(runs, prs, robot)
     assign_paths(prs)
+    for i in range(0, len(halved), 2):  # the halves of a run: one path, split together
+        prs[halved[i + 1]].path = prs[halved[i]].path
     assign_shapes(prs)
     ds = Dataset(robot, str(robot_path), folders, runs, prs, [], mode, groups, return_accuracy)
+    ds.halved = [runs[i].name.removesuffix("-h1") for i in halved[::2]]
     try:
         if mode == "truth":
             ds.instrument, ds.notes = instrument.estimate(prs, robot.n_trucks)
@@ -154,6 +172,25 @@ def load(
     except ValueError as e:
         raise GapInputError(folders[0], f"mode {mode}: {e}") from None
     return ds
+
+
+def _halve_lone(runs: list[RunData], prs: list[Prepared], robot: Robot) -> tuple:
+    """(runs, prepared runs, indices of the halves in pairs) with every run that is its kind's
+    only one (paths.lone_kinds) replaced by its halves (io.halves at paths.cut_tick); a run
+    whose halves would be shorter than HALF_MIN_S stays whole."""
+    lone = set(lone_kinds(prs))
+    out_r, out_p, pairs = [], [], []
+    for i, (r, pr) in enumerate(zip(runs, prs, strict=True)):
+        k = cut_tick(pr) if i in lone else 0
+        if i not in lone or min(pr.t[k] - pr.t[0], pr.t[-1] - pr.t[k]) < HALF_MIN_S:
+            out_r.append(r)
+            out_p.append(pr)
+            continue
+        for h in halves(r, k):
+            pairs.append(len(out_r))
+            out_r.append(h)
+            out_p.append(prepare(h, robot))
+    return out_r, out_p, pairs
 
 
 def _lever_on_arcs(ds: Dataset) -> None:
@@ -310,9 +347,18 @@ def select_runs(
         return explicit(ds.runs, fit, judge, ds.groups)
     if judge:
         raise GapInputError("--judge", "needs --fit too (which runs to fit on)")
-    return stratified(
+    sel = stratified(
         [group_key(pr) for pr in ds.prs], holdout, seed, [motion_kind(pr) for pr in ds.prs]
     )
+    if ds.halved and not sel.in_sample:
+        one = len(ds.halved) == 1
+        sel = Selection(
+            sel.fit,
+            sel.held,
+            f"{sel.how}; {', '.join(ds.halved)}, the only run of {'its' if one else 'their'} "
+            f"kind of motion, {'is' if one else 'are'} cut in two, one half fitted and one judged",
+        )
+    return sel
 
 
 @dataclass
@@ -1350,7 +1396,7 @@ def _diagnose(
     real, robot_path, holdout, seed, mode, progress, return_accuracy, fit, judge_runs, groups
 ) -> Report:
     t0 = time.perf_counter()
-    ds = load(real, robot_path, mode, return_accuracy, groups)
+    ds = load(real, robot_path, mode, return_accuracy, groups, halve=not fit and holdout > 0)
     sel = select_runs(ds, holdout, seed, fit, judge_runs)
     rk = rank(ds, sel, progress)
     if not rk.retimed and (_relatency(ds, sel, rk) or _slip_not_latency(ds, sel, rk.prob, rk.best)):

@@ -450,6 +450,36 @@ class RunData:
     path: str = ""  # the log file
 
 
+HALF_LEAD_IN_S = 1.0  # frames before the cut that the second half's model runs through first
+
+
+def halves(run: RunData, k: int) -> tuple[RunData, RunData]:
+    """A run cut at frame k (paths.cut_tick) into '<name>-h1', its frames up to k, and
+    '<name>-h2', its truth from frame k on. The second half's frames start HALF_LEAD_IN_S
+    earlier: the slip laws' states (a wheel's speed before the tick, a rate limiter's, a
+    motor's) start from rest, and a half that starts at speed gave its first tick a 50 % slip
+    (independent world, dev seed 2851 case 29); run through the lead-in, whose truth is cut
+    away, they reach the cut where the whole run had them. The model is anchored where the
+    truth starts (modes.TruthMode.anchored). Neither half has a return pose."""
+    lg, tr = run.log, run.truth
+
+    def part(a: int, b: int, t_from: float, tag: str) -> RunData:
+        cut = lambda x: None if x is None else x[a:b]  # noqa: E731
+        log = SensorLog(
+            lg.path, lg.t_s[a:b], lg.counts[a:b], cut(lg.alpha_deg), cut(lg.beta_deg),
+            cut(lg.l_mm), 0, cut(lg.skipped),
+        )  # fmt: skip
+        truth = None
+        if tr is not None:
+            m = (tr.t_s >= t_from) & (tr.t_s <= log.t_s[-1] + 1.0)
+            truth = Truth(tr.path, tr.t_s[m], tr.pose[m], None if tr.link is None else tr.link[m])
+        return RunData(f"{run.name}-{tag}", run.direction, log, truth, None, run.session, run.path)
+
+    t = lg.t_s
+    lead = int(np.searchsorted(t, t[k] - HALF_LEAD_IN_S))
+    return part(0, k + 1, -math.inf, "h1"), part(lead, t.size, float(t[k]), "h2")
+
+
 def discover(real: str | Path, robot: Robot) -> list[RunData]:
     """Every run in a folder: run-<dir>-NN.log, optional .truth.csv, optional returns.csv."""
     real = Path(real)
