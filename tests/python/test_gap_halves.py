@@ -101,3 +101,18 @@ def test_an_explicit_selection_keeps_every_run_whole(real: Path) -> None:
     assert d["heldout"]["runs"] == ["run-outback-01", "run-shuttle-01"]
     assert "cut in two" not in d["selection"]
 
+
+def test_a_cable_met_the_other_way_is_placed_on_the_judged_half(tmp_path: Path) -> None:
+    """Dev seed 2831 case 42: a LabMate's floor steps (cables), which the squares and a shuttle
+    cross. The shuttle is the only straight run, so it is cut in two, and its judged half
+    crosses two of the cables on its way back, against the way the squares and its fitted half
+    met them. Placed only where a wheel rolled the way the fitting runs did, those cables were
+    left out of the judged half (7.1 mm of its misfit) and the verdict was "unexplained" (R 12.2
+    -> 6.8)."""
+    real = tmp_path / "real"
+    indep_case(2831, 42, real, "labmate", {"bumps": "steps"})
+    rep = D.diagnose(real, real / "robot.json", mode="truth").to_dict()
+    assert rep["verdict"]["effect"] == "bumps", rep["verdict"]
+    h = rep["heldout"]
+    i = h["runs"].index("run-shuttle-01-h2")
+    assert h["before"][i]["mm"] > 5.0 and h["after"][i]["mm"] < 0.5 * h["before"][i]["mm"], h
