@@ -299,3 +299,20 @@ def test_a_member_the_tracks_do_not_need_leaves_the_pair(tmp_path, monkeypatch) 
     monkeypatch.setattr(D, "_track_refit", lambda *a, **k: False)
     rep = diagnosed()
     assert "the rest is not needed there" in rep["proposals"]["the accumulated track"]
+
+
+def test_an_es_the_tracks_choose_is_the_floor_when_the_walk_accounts_for_it(
+    tmp_path: Path, monkeypatch
+) -> None:
+    """Dev seed 2851 case 54: a LabMate on a rough surface (the independent world's own
+    roughness law). The windows named roughness + slip, the track refit replaced it with an Es,
+    and the floor's rule (diagnose._floor_or_scale: an Es whose shortening the measured walk
+    accounts for is the floor) was not asked again: "es". Its runs are kept whole, as they were
+    then: with its only oval cut in two (test_gap_halves.py) the windows' best is roughness
+    alone and the track refit is not needed."""
+    real = tmp_path / "real"
+    indep_case(2851, 54, real, "labmate", {"roughness": "surface"})
+    monkeypatch.setattr(D, "lone_kinds", lambda prs: [])
+    rep = D.diagnose(real, real / "robot.json", mode="truth").to_dict()
+    assert rep["verdict"]["effect"] == "roughness", rep["verdict"]
+    assert "es fitted to the tracks" in rep["proposals"]["the accumulated track"]
