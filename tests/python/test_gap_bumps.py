@@ -92,14 +92,24 @@ def test_a_spot_one_other_path_agreed_on_stays_on_that_path() -> None:
     assert held.pr.bumps == []
 
 
-def test_a_spot_met_from_the_other_side_or_already_placed_is_not_placed_again() -> None:
-    # a ramp's s0 is where the wheel meets it: from the other side that is another spot
+def test_a_spot_met_from_the_other_side_is_placed_and_one_already_placed_is_not() -> None:
+    # a cable, a strip or a speed bump is met from both sides: fitting runs that rolled over it
+    # against the held-out wheel's way still place it (dev seed 2831 case 42: a half-shuttle's
+    # way back over two cables), once
     back = [
         _bump("ccw:1", ["run-ccw-02"], 1190.0, -198.0, way=np.pi),
         _bump("outback:1", ["run-outback-01"], 1215.0, -205.0, way=-np.pi),
     ]
     held = _run("cw:1")
     bumps.place_floor_bumps([held], back, min_runs=2)
+    assert len(held.pr.bumps) == 1 and held.pr.bumps[0]["h"] == pytest.approx(9.0)
+    # ... and not where the wheel passes beside the spot, rolling across its way
+    side = [
+        _bump("ccw:1", ["run-ccw-02"], 1190.0, -198.0, way=0.5 * np.pi),
+        _bump("outback:1", ["run-outback-01"], 1215.0, -205.0, way=0.5 * np.pi),
+    ]
+    held.pr.bumps = []
+    bumps.place_floor_bumps([held], side, min_runs=2)
     assert held.pr.bumps == []
     # the path placement put one 100 mm before the spot: the same bump, met where it starts
     floor = [
