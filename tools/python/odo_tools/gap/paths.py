@@ -125,7 +125,7 @@ def assign_shapes(prs: list[Prepared]) -> None:
 # always fitted and its kind never judged: a LabMate whose wheelbase grows on arcs drove its
 # only arcs on one oval, the held-out squares saw nothing of it, and a gap of 46 x the background
 # on the fitting tracks, closed by the scrub to 1.06 x, was called "no significant gap"
-# (independent world, dev seeds 2831 cases 18 and 26, 2851 case 10).
+# (independent world, dev seed 2831 cases 18 and 26).
 HALF_MIN_S = 4.0  # a half shorter than this (ten 0.4 s windows) is too short to judge
 
 
