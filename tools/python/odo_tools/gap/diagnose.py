@@ -181,8 +181,8 @@ def _halve_lone(runs: list[RunData], prs: list[Prepared], robot: Robot) -> tuple
     lone = set(lone_kinds(prs))
     out_r, out_p, pairs = [], [], []
     for i, (r, pr) in enumerate(zip(runs, prs, strict=True)):
-        k = cut_tick(pr) if i in lone else 0
-        if i not in lone or min(pr.t[k] - pr.t[0], pr.t[-1] - pr.t[k]) < HALF_MIN_S:
+        k = cut_tick(pr) if i in lone else None
+        if k is None or min(pr.t[k] - pr.t[0], pr.t[-1] - pr.t[k]) < HALF_MIN_S:
             out_r.append(r)
             out_p.append(pr)
             continue

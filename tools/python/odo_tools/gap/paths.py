@@ -60,12 +60,17 @@ SHAPE_HEADING_TOL_RAD = 0.35
 SPOT_SHARE = 0.5  # share of the turning done on the spot that makes a shape "spot turns"
 
 
-def turn_style(pr: Prepared) -> tuple[float, float]:
-    """(heading turned on the spot, heading turned on arcs) of truck A, rad, from the counts."""
+def _turning(pr: Prepared) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Per tick of truck A, from the counts: heading turned (rad), on the spot, on an arc."""
     ds = pr.ds[:, 0, :]
     dth = np.abs(ds[:, 1] - ds[:, 0]) / pr.b[0]
     spot = (ds[:, 0] * ds[:, 1]) < 0.0
-    arc = (~spot) & (dth > 1e-4)
+    return dth, spot, (~spot) & (dth > 1e-4)
+
+
+def turn_style(pr: Prepared) -> tuple[float, float]:
+    """(heading turned on the spot, heading turned on arcs) of truck A, rad, from the counts."""
+    dth, spot, arc = _turning(pr)
     return float(dth[spot].sum()), float(dth[arc].sum())
 
 
@@ -132,9 +137,9 @@ HALF_MIN_S = 4.0  # a half shorter than this (ten 0.4 s windows) is too short to
 def lone_kinds(prs: list[Prepared]) -> list[int]:
     """Indices of the runs that are the only run of their kind of motion (motion_kind), when
     other runs exist."""
-    kinds = [motion_kind(pr) for pr in prs]
     if len(prs) < 2:
         return []
+    kinds = [motion_kind(pr) for pr in prs]
     return [i for i, k in enumerate(kinds) if kinds.count(k) == 1]
 
 
@@ -142,15 +147,13 @@ def cut_tick(pr: Prepared) -> int:
     """The tick that cuts a run into halves with as much of its kind of motion each: half its
     arc turning (an arc run), half its spot turning (a spot-turn run), half its travel
     (straight). A drive whose arcs all come in its second half is cut inside them."""
-    ds = pr.ds[:, 0, :]
-    dth = np.abs(ds[:, 1] - ds[:, 0]) / pr.b[0]
-    spot = (ds[:, 0] * ds[:, 1]) < 0.0
+    dth, spot, arc = _turning(pr)
     kind = motion_kind(pr)
     if kind == "arc":
-        w = np.where((~spot) & (dth > 1e-4), dth, 0.0)
+        w = np.where(arc, dth, 0.0)
     elif kind == "spot":
         w = np.where(spot, dth, 0.0)
     else:
-        w = np.abs(ds).mean(axis=1)
+        w = np.abs(pr.ds[:, 0, :]).mean(axis=1)
     c = np.cumsum(w)
-    return int(np.searchsorted(c, 0.5 * c[-1])) + 1 if c[-1] > 0 else ds.shape[0] // 2
+    return int(np.searchsorted(c, 0.5 * c[-1])) + 1 if c[-1] > 0 else w.size // 2
