@@ -162,21 +162,31 @@ def test_verdict_reads_the_held_out_misfit_against_the_background(r0, r1, dbic, 
 
 
 @pytest.mark.parametrize(
-    ("r0", "r1", "dbic", "weak", "dof", "expect"),
+    ("r0", "r1", "dbic", "weak", "dof", "track", "expect"),
     [
-        (1.97, 0.93, 1670.0, True, None, "ed"),  # dev 2801 case 22: both sides agree
-        (1.97, 0.93, 1670.0, False, None, "no significant gap"),  # returns, linkage: not asked
-        (1.97, 0.93, 60.0, True, None, "no significant gap"),  # the fitting runs barely want it
-        (1.8, 1.45, 500.0, True, None, "no significant gap"),  # removes 52 %: not closed
-        (1.45, 1.0, 500.0, True, None, "no significant gap"),  # below 1.5 x: background
-        (1.9, 1.0, 500.0, True, 3.0, "no significant gap"),  # a few runs' spread: F's gap rules
+        (1.97, 0.93, 1670.0, True, None, None, "ed"),  # dev 2801 case 22: both sides agree
+        (1.97, 0.93, 1670.0, False, None, None, "no significant gap"),  # returns, linkage
+        (1.97, 0.93, 60.0, True, None, None, "no significant gap"),  # the fitting runs barely
+        (1.8, 1.45, 500.0, True, None, None, "no significant gap"),  # removes 52 %: not closed
+        (1.45, 1.0, 500.0, True, None, None, "no significant gap"),  # below 1.5 x: background
+        (1.9, 1.0, 500.0, True, 3.0, None, "no significant gap"),  # a few runs' spread: F's
+        # the fitting runs' tracks agree instead of their Delta BIC (dev 2821 case 55)
+        (1.86, 0.94, 68.0, True, None, 1.85, "ed"),
+        (1.86, 0.94, 68.0, True, None, 1.2, "no significant gap"),  # the tracks see no gap
+        # both sides see the gap and nothing closes it (dev 2821 case 14, a gear backlash)
+        (1.87, 1.93, -2.0, True, None, 2.04, "unexplained"),
+        (1.78, 6.29, 17.0, True, None, 0.81, "no significant gap"),  # dev 2831 case 20: none
+        (1.87, 1.93, -2.0, False, None, 2.04, "no significant gap"),  # returns, linkage
+        (1.45, 1.45, -2.0, True, None, 2.04, "no significant gap"),  # held out: background
     ],
 )
 def test_a_gap_below_twice_the_background_is_named_where_both_sides_agree(
-    r0, r1, dbic, weak, dof, expect
+    r0, r1, dbic, weak, dof, track, expect
 ) -> None:
-    """Truth mode names a gap of 1.5-2 x the background when the fitting runs want the candidate
-    by Delta BIC >= 100 and it removes >= 75 % of the held-out excess; never "unexplained"."""
+    """Truth mode judges a gap of 1.5-2 x the background by what the fitting runs say: named
+    when they want the candidate by Delta BIC >= 100 or their own nominal tracks sit at >= 1.5 x,
+    and it removes >= 75 % of the held-out excess; "unexplained" when the tracks see the gap and
+    the candidate does not close it; else no significant gap."""
     from odo_tools.gap.heldout import HeldOut, RunGap
     from odo_tools.gap.verdict import decide
 
@@ -184,7 +194,7 @@ def test_a_gap_below_twice_the_background_is_named_where_both_sides_agree(
     h = HeldOut([], runs, runs, [], [], ratio_before=r0, ratio_after=r1)
     if dof is not None:
         h.extra["noise_dof"] = dof
-    verdict, reason = decide(h, dbic, "ed", weak_gap=weak)
+    verdict, reason = decide(h, dbic, "ed", weak_gap=weak, fit_track=track)
     assert verdict == expect, reason
 
 
@@ -437,3 +447,20 @@ def test_a_session_whose_runs_disagree_keeps_only_long_latencies() -> None:
     out = session_latencies(prs, found)
     assert [out[f"r{k}"] for k in range(9)] == [0.0] * 9
     assert out["r9"] == 0.070
+
+
+def test_a_weak_gap_both_sides_see_and_nothing_closes_is_unexplained(tmp_path: Path) -> None:
+    """The independent world's dev seed 2821 case 14: a LabMate with gear backlash (out of the
+    catalog). Its held-out runs sit at 1.5-2 x the background, its fitting runs' nominal tracks
+    beyond 1.5 x as well, and no candidate closes the gap: "unexplained" (it was "no
+    significant gap", read from the held-out runs alone)."""
+    from odo_tools.gap.diagnose import diagnose
+
+    real = tmp_path / "real"
+    indep_case(2821, 14, real, "labmate", {"gear_backlash": "play"})
+    v = diagnose(real, real / "robot.json", mode="truth")["verdict"]
+    ev = v["evidence"]
+    assert v["effect"] == "unexplained", v["reason"]
+    assert 1.5 <= ev["heldout_ratio_before"] < 2.0, ev
+    assert ev["fit_track_ratio_nominal"] >= 1.5, ev
+    assert ev["heldout_ratio_after"] > 1.5, ev

@@ -64,7 +64,7 @@ from .report import Context, Report
 from .select import Selection, explicit, parse_groups, stratified
 from .stability import analyse as stability
 from .stability import drift
-from .verdict import R_GAP, R_WITHIN, decide
+from .verdict import R_GAP, R_WITHIN, decide, weak_zone
 from .where import phase_excess, truck_excess, where_analysis
 
 Progress = Callable[[str], None] | None
@@ -1135,7 +1135,14 @@ def judge(ds: Dataset, sel: Selection, rk: Ranking) -> Judgement:
     if ds.mode == "truth" and ds.instrument is not None:
         # under the best candidate, as the latencies above: an Es read -420 ppm on the nominal
         ds.clock = instrument.clock_rate(ds.prs, ds.instrument, rk.best.model_params())
-    verdict, reason = decide(held, dbic, rk.best.label, weak_gap=ds.mode == "truth")
+    truth = ds.mode == "truth"
+    fit_track = None
+    if truth and weak_zone(held):  # the fitting runs' word on a weak gap (verdict.py)
+        fit_track = evaluate_heldout(
+            items, ds.prs, list(sel.fit), None, rk.prob.sigma, bg, boot=0
+        ).ratio_before
+        held.extra["fit_track_ratio_nominal"] = fit_track
+    verdict, reason = decide(held, dbic, rk.best.label, weak_gap=truth, fit_track=fit_track)
     return Judgement(verdict, reason, bg, held, dbic)
 
 
@@ -1158,16 +1165,18 @@ def _decoders_word(ds: Dataset, sel: Selection, rk: Ranking, jd: Judgement) -> J
         why = catalog.not_identifiable(ds.mode, ds.robot.vehicle).get("count_loss", "")
         jd.reason += f"; {said}: count loss, which {ds.mode} mode cannot size ({why})"
         return jd
-    if jd.verdict == "unexplained":
+    # a weak gap both sides see (verdict.py) is no gap the flags leave unexplained
+    quiet = ("no significant gap", "unexplained")
+    if jd.verdict == "unexplained" and not weak_zone(jd.held):
         return jd
     cl = [f for f in rk.cands if f.hyp is not None and f.hyp.families == ("count_loss",)]
-    if jd.verdict != "no significant gap":
+    if jd.verdict not in quiet:
         return _with_count_loss(ds, sel, rk, jd, cl, said)
     if not cl:
         return jd
     rk.best = min(cl, key=lambda f: f.bic)
     again = judge(ds, sel, rk)
-    if again.verdict != "no significant gap":
+    if again.verdict not in quiet or (again.verdict == "unexplained" and not weak_zone(again.held)):
         return again
     again.verdict = "count_loss"
     again.reason = (

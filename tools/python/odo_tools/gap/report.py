@@ -244,6 +244,8 @@ class Report:
                 "overdispersion": rk.c_hat,
                 "heldout_ratio_before": held.ratio_before,
                 "heldout_ratio_after": held.ratio_after,
+                # truth, a weak held-out gap: the fitting runs' tracks, nominal (verdict.py)
+                "fit_track_ratio_nominal": held.extra.get("fit_track_ratio_nominal"),
             },
             "bumps": best.bumps,
         }
