@@ -47,6 +47,15 @@ def test_scores_have_every_figure(blind: Path) -> None:
     # the wall time of a 10-run diagnosis is a benchmark figure (printed by the blind run, quoted
     # in the README), never a timed assertion: here only that it was measured
     assert s["diagnose_10runs_s"] > 0
+    slowest = s["diagnose_s_max"]
+    assert slowest["s"] >= s["diagnose_10runs_s_max"] and slowest["runs"] >= 2
+
+
+def test_a_run_cut_in_halves_counts_once_toward_the_10_run_figure() -> None:
+    from odo_tools.validation.blind import recorded_runs
+
+    names = ["run-cw-01", "run-ccw-01", "run-oval-01-h1", "run-oval-01-h2", "run-h1-01"]
+    assert recorded_runs(names) == 4
 
 
 def test_keys_are_kept_apart_from_the_recorded_data(blind: Path) -> None:

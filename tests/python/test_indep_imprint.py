@@ -102,7 +102,7 @@ def _res(k: int, mode: str, verdict: str) -> dict:
     return {
         "real": f"/x/case-{k:03d}/real",
         "mode": mode,
-        "report": {"verdict": v, "elapsed_s": 1.0, "shrink": 1.0},
+        "report": {"verdict": v, "elapsed_s": 1.0, "shrink": 1.0, "runs": ["run-cw-01"]},
     }
 
 

@@ -470,6 +470,11 @@ def _jsonable(o):
     raise TypeError(type(o).__name__)
 
 
+def recorded_runs(names: list[str]) -> int:
+    """How many runs were recorded, a run cut in halves (gap.io.halves) counted once."""
+    return len({n.removesuffix("-h1").removesuffix("-h2") for n in names})
+
+
 def headline(s: dict) -> dict:
     """The figures the README quotes, one line."""
     keys = (
@@ -483,6 +488,7 @@ def headline(s: dict) -> dict:
         "shrink_median",
         "diagnose_10runs_s",
         "diagnose_10runs_s_max",
+        "diagnose_s_max",
     )
     out = {k: s.get(k) for k in keys}
     vis = s.get("visible_only") or {}
@@ -645,7 +651,7 @@ def score(cases: list[dict], results: list[dict]) -> dict:
         if "report" not in r:
             continue
         rep = r["report"]
-        times.append(rep["elapsed_s"])
+        times.append((rep["elapsed_s"], recorded_runs(rep["runs"])))
         if c["kind"] in ("single", "pair") and pred == lab:
             shr.append(rep["shrink"])
             for e in c["effects"]:
@@ -674,6 +680,7 @@ def score(cases: list[dict], results: list[dict]) -> dict:
                             )
                         )
     med = lambda x: float(np.median(x)) if x else float("nan")  # noqa: E731
+    ten = [t for t, n in times if n <= 10]
     return {
         "top1_accuracy": per_mode["truth"][0],
         "top1_cases": per_mode["truth"][1],
@@ -692,8 +699,11 @@ def score(cases: list[dict], results: list[dict]) -> dict:
         "param_rel_err_median": med(rel),
         "bump_loc_err_mm_median": med(loc),
         "shrink_median": med(shr),
-        "diagnose_10runs_s": med(times),
-        "diagnose_10runs_s_max": max(times) if times else float("nan"),
+        # issue 13's target is for a 10-run diagnosis: the cases of up to 10 recorded runs, and
+        # beside them the slowest case of any size (the world draws up to 13 runs)
+        "diagnose_10runs_s": med(ten),
+        "diagnose_10runs_s_max": max(ten) if ten else float("nan"),
+        "diagnose_s_max": ({"s": max(times)[0], "runs": max(times)[1]} if times else None),
         "confusion": conf,
         "per_case": per_case,
         "scoring": "top-1 per mode over catalog cases (single and pair) whose effects the catalog "
