@@ -94,6 +94,17 @@ def test_a_friction_circle_skid_is_named_with_its_limit(tmp_path: Path) -> None:
     assert rep["heldout"]["ratio_after"] < 0.1 * rep["heldout"]["ratio_before"]
 
 
+def test_a_friction_skid_read_after_the_arcs_is_tried_unproposed(tmp_path: Path) -> None:
+    """Independent world, seed 2951 case 30: a LabMate whose two fast circles skid 232 and
+    342 mm, 92 % of it on the straights after them, so no phase proposes the friction circle;
+    the cornering law left the held-out runs at 64 x the background, "unexplained". Tried on
+    every robot (hypotheses.ALWAYS) the friction circle names it and closes the gap."""
+    c, rep = indep_named(2951, 30, tmp_path, "labmate", {"skid": "friction"}, "skid", "friction")
+    true = c["true"]["effects"]["skid"]["a_lim_m_s2"]
+    assert rep["verdict"]["params"]["skid@friction.a_lim_m_s2"] == pytest.approx(true, rel=0.1)
+    assert rep["heldout"]["ratio_before"] > 20.0 and rep["heldout"]["ratio_after"] < 1.5
+
+
 def test_a_wheelbase_under_lateral_load_is_named_eb_alone(tmp_path: Path) -> None:
     """Independent world, seed 2721 case 10: a LabMate whose wheelbase is 0.987 on the spot and
     grows 17 % of the lateral acceleration in g. The catalog's Eb needed a scrub beside it
