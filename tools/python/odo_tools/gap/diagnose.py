@@ -1137,7 +1137,8 @@ def judge(ds: Dataset, sel: Selection, rk: Ranking) -> Judgement:
         ds.clock = instrument.clock_rate(ds.prs, ds.instrument, rk.best.model_params())
     truth = ds.mode == "truth"
     fit_track = None
-    if truth and weak_zone(held):  # the fitting runs' word on a weak gap (verdict.py)
+    # the fitting runs' word on a weak gap (verdict.py), on robots whose trucks are all driven
+    if truth and weak_zone(held) and all(ds.prs[0].driven):
         fit_track = evaluate_heldout(
             items, ds.prs, list(sel.fit), None, rk.prob.sigma, bg, boot=0
         ).ratio_before

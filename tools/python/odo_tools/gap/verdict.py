@@ -26,7 +26,11 @@ DBIC_WEAK_GAP = 100.0
 # (`fit_track`). Out-of-catalog effects sat there as "no significant gap" (dev seeds 2821-2851:
 # 8 of 53, tracks of the fitting runs at 1.7-2.8 x). Of 86 robots with no effect (dev 2701-2851)
 # three reached the zone: 2831 case 20 (R 1.78, tracks 0.81 x) stays, two sets (2711 case 56,
-# 2751 case 57: R 1.55 and 1.51, tracks 2.68 and 1.65 x) become false alarms
+# 2751 case 57: R 1.55 and 1.51, tracks 2.68 and 1.65 x) became false alarms, and so did two
+# sets of fresh seed 2971 (cases 47 and 58, R 1.59 and 1.83), against two out-of-catalog sets
+# called right (2831 case 47, 2841 case 36). A set's trailer is dragged, not driven, and the
+# rule is asked only where every truck is driven (diagnose.judge); which of a set's trucks
+# carries its weak gap was not traced
 R_WITHIN = 1.5  # after the fit, within 1.5 x the background: the effect is named
 EXCESS_REMOVED = 0.75  # ... or it removes this share of the held-out misfit above background
 
