@@ -60,32 +60,30 @@ def test_cornering_skid_below_the_catalog_threshold_is_named(tmp_path: Path) -> 
     assert rep["heldout"]["ratio_after"] < 1.5
 
 
-def test_the_cornering_law_is_tried_unproposed_and_the_friction_circle_only_on_arcs() -> None:
+def test_the_skid_laws_are_tried_unproposed_and_join_no_pair_unproposed() -> None:
     """hypotheses.tried_laws: without a proposal a ranking fits the load law, the cornering
-    skid, Ed's speed law and slip's traction laws beside the catalog's laws, not the friction
-    circle (it limits starts as well as turns); arcs that hold the misfit bring it; returns
-    mode, which cannot see a skid, gets no skid law; a proposed family brings every one of its
-    laws. An unproposed law is no partner (hypotheses.unproposed)."""
+    skid, the friction circle (a skid read on the straights after the arcs proposes nothing:
+    independent 2951 case 30), Ed's speed law and slip's traction laws beside the catalog's
+    laws; returns mode, which cannot see a skid, gets no skid law; a proposed family brings
+    every one of its laws. An unproposed law is no partner (hypotheses.unproposed): the friction
+    circle, which limits starts as well as turns, once joined a LabMate's slip as a "skid"."""
     from odo_tools.gap.hypotheses import tried_laws, unproposed
 
     def names(proposals: dict, mode: str = "truth", vehicle: str = "labmate") -> list[str]:
         return [h.name for h in tried_laws(proposals, mode, vehicle)]
 
     traction = ["slip@traction", "slip@motor"]  # a floor short of the motor's torque: everywhere
-    assert names({}) == ["eb@load", "skid@cornering", "ed@growth", *traction]
-    assert names({"skid": "arcs"}) == [
-        "eb@load",
-        "skid@cornering",
-        "skid@friction",
-        "ed@growth",
-        *traction,
-    ]
+    skids = ["skid@cornering", "skid@friction"]
+    assert names({}) == ["eb@load", *skids, "ed@growth", *traction]
+    assert names({"skid": "arcs"}) == names({})
     assert names({}, "returns") == ["eb@load", "ed@growth", *traction]
     assert "skid@cornering" not in names({}, "returns")
     # unproposed, the cornering law may lead alone but joins no pair (2721 case 13: "ed+skid")
     laws = {h.name: h for h in tried_laws({}, "truth", "set")}
     assert unproposed(laws["skid@cornering"], {})
     assert not unproposed(laws["skid@cornering"], {"skid": "arcs"})
+    assert unproposed(laws["skid@friction"], {})
+    assert not unproposed(laws["skid@friction"], {"skid": "arcs"})
     assert not unproposed(laws["eb@load"], {})
     assert unproposed(laws["ed@growth"], {})  # a tyre growing with speed leads alone, too
     assert unproposed(laws["slip@motor"], {})  # and traction slip where no phase proposes slip
