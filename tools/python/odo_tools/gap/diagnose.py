@@ -1147,6 +1147,14 @@ def judge(ds: Dataset, sel: Selection, rk: Ranking) -> Judgement:
     return Judgement(verdict, reason, bg, held, dbic)
 
 
+def _quiet(jd: Judgement) -> bool:
+    """No effect named: no significant gap, or a weak gap both sides see that nothing closes
+    (verdict.py), which the decoders' own flags may still name."""
+    return jd.verdict == "no significant gap" or (
+        jd.verdict == "unexplained" and weak_zone(jd.held)
+    )
+
+
 def _decoders_word(ds: Dataset, sel: Selection, rk: Ranking, jd: Judgement) -> Judgement:
     """Count loss the wheel decoders report themselves (WHEEL_COUNTS Status: a skipped
     quadrature state) is a reading, not a hypothesis: where the held-out runs show no
@@ -1166,18 +1174,16 @@ def _decoders_word(ds: Dataset, sel: Selection, rk: Ranking, jd: Judgement) -> J
         why = catalog.not_identifiable(ds.mode, ds.robot.vehicle).get("count_loss", "")
         jd.reason += f"; {said}: count loss, which {ds.mode} mode cannot size ({why})"
         return jd
-    # a weak gap both sides see (verdict.py) is no gap the flags leave unexplained
-    quiet = ("no significant gap", "unexplained")
-    if jd.verdict == "unexplained" and not weak_zone(jd.held):
+    if jd.verdict == "unexplained" and not _quiet(jd):
         return jd
     cl = [f for f in rk.cands if f.hyp is not None and f.hyp.families == ("count_loss",)]
-    if jd.verdict not in quiet:
+    if not _quiet(jd):
         return _with_count_loss(ds, sel, rk, jd, cl, said)
     if not cl:
         return jd
     rk.best = min(cl, key=lambda f: f.bic)
     again = judge(ds, sel, rk)
-    if again.verdict not in quiet or (again.verdict == "unexplained" and not weak_zone(again.held)):
+    if not _quiet(again):
         return again
     again.verdict = "count_loss"
     again.reason = (

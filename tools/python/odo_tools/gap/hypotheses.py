@@ -273,28 +273,26 @@ PROPOSE = {
     "count_loss": ("fast",),
     "skid": ("arc",),
 }
-# other laws always tried, whatever the phases propose ("family": all of its laws, or
-# "family@law"): a load-dependent Eb shows in no one phase (every arc, more so the faster), and
-# one cheap fit beside the catalog's Eb costs less than missing it; a cornering skid's outward
-# step is made on the arc but read on the straight after it, where no phase proposes it
-# (independent world, seed 2761 case 1: 86 % of the excess on the straights, and a scrub that
-# took the held-out runs from 14.6 to 402 x the background led the ranking). The friction
-# circle's skid is read there too: a LabMate's two fast circles of three skidded 232 and 342 mm,
-# 92 % of it on the straights after them, so nothing proposed the law and the cornering law left
-# 64 x (independent seed 2951 case 30; the friction circle, tried, 1.16 x). It was left out
-# once because it joined a LabMate's slip as a "skid" (2761 case 22); unproposed it joins no
-# pair now, and that case and the 240 truth cases of dev seeds 2821-2851 keep their verdicts
-# (one clapper's clock drift more "unexplained"). A joint encoder's offset that varies with the
-# angle (a disc off centre) shows in no phase either; as a constant it left a set's held-out
-# runs at 2.8 x the background (2741 case 40: 1.1 x once per turn), and it costs no dead
-# reckoning. A tyre that
-# grows with speed acts wherever the robot drives fast, turning or not, and the phases' "fast"
-# share proposes count loss; as a fixed Ed it was "ed + scrub" twice (2791 cases 32 and 50).
-# Unproposed it leads alone and joins no pair (`unproposed`). A floor that cannot follow the
-# motor's torque (traction saturation) loses travel at every start and stop, and where it loses
-# much the track is off everywhere after the first start: the phases then proposed nothing and the
-# catalog's slip, fitted alone, left a LabMate's held-out runs worse than the nominal model
-# (independent seeds 2791 case 51, 2801 case 58: "unexplained")
+# other laws always tried, whatever the phases propose ("family": all of its laws, or "family@law"):
+# a load-dependent Eb shows in no one phase (every arc, more so the faster), and one cheap fit
+# beside the catalog's Eb costs less than missing it; a cornering skid's outward step is made on the
+# arc but read on the straight after it, where no phase proposes it (independent world, seed 2761
+# case 1: 86 % of the excess on the straights, and a scrub that took the held-out runs from 14.6 to
+# 402 x the background led the ranking). The friction circle's skid is read there too: a LabMate's
+# two fast circles of three skidded 232 and 342 mm, 92 % of it on the straights after them, so
+# nothing proposed the law and the cornering law left 64 x (independent seed 2951 case 30; the
+# friction circle, tried, 1.16 x). It was left out once because it joined a LabMate's slip as a
+# "skid" (2761 case 22); unproposed it joins no pair now, and that case and the 240 truth cases of
+# dev seeds 2821-2851 keep their verdicts (one clapper's clock drift more "unexplained"). A joint
+# encoder's offset that varies with the angle (a disc off centre) shows in no phase either; as a
+# constant it left a set's held-out runs at 2.8 x the background (2741 case 40: 1.1 x once per
+# turn), and it costs no dead reckoning. A tyre that grows with speed acts wherever the robot drives
+# fast, turning or not, and the phases' "fast" share proposes count loss; as a fixed Ed it was "ed +
+# scrub" twice (2791 cases 32 and 50). Unproposed it leads alone and joins no pair (`unproposed`). A
+# floor that cannot follow the motor's torque (traction saturation) loses travel at every start and
+# stop, and where it loses much the track is off everywhere after the first start: the phases then
+# proposed nothing and the catalog's slip, fitted alone, left a LabMate's held-out runs worse than
+# the nominal model (independent seeds 2791 case 51, 2801 case 58: "unexplained")
 ALWAYS = (
     "eb",
     "skid@cornering",

@@ -83,7 +83,7 @@ def decide(
     tracks_see = fit_track is not None and fit_track >= R_GAP_WEAK
     if (
         weak_gap
-        and R_GAP_WEAK <= r0 < rg == R_GAP
+        and weak_zone(held)
         and (dbic >= DBIC_WEAK_GAP or tracks_see)
         and removed >= EXCESS_REMOVED
     ):
