@@ -138,3 +138,63 @@ def test_track_cache_answers_each_truck_for_its_own_parameters() -> None:
     assert np.array_equal(dead_reckon(pr, slip, 1), nomB)  # the trailer rolls passively
     assert not np.allclose(dead_reckon(pr, slip, 0), nomA)
     assert math.isfinite(float(movedB[-1, 0]))
+
+
+def _track_at_plain(tq, t: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """model.track_at as it was before its weights were kept (TrackAt): searched and weighted on
+    every call."""
+    tq = np.asarray(tq, dtype=float)
+    n = t.size
+    if n < 3:
+        return np.interp(tq, t, y) if y.ndim == 1 else np.stack(
+            [np.interp(tq, t, y[:, c]) for c in range(y.shape[1])], axis=-1)
+    k = np.clip(np.searchsorted(t, tq, side="right") - 1, 0, n - 2)
+    km, kp = np.maximum(k - 1, 0), np.minimum(k + 2, n - 1)
+    t0, t1 = t[k], t[k + 1]
+    h = t1 - t0
+    u = np.clip((tq - t0) / h, 0.0, 1.0)
+    a, c = h / (t1 - t[km]), h / (t[kp] - t0)
+    if y.ndim > 1:
+        u, a, c = u[..., None], a[..., None], c[..., None]
+    y0, y1 = y[k], y[k + 1]
+    d = y1 - y0
+    w = 1.0 - u
+    return y0 + u * (d + w * (w * ((y1 - y[km]) * a - d) - u * ((y[kp] - y0) * c - d)))
+
+
+@pytest.mark.parametrize("ticks", [2, 3, 400])
+def test_track_at_fixed_times_is_the_plain_form_bit_for_bit(ticks: int) -> None:
+    """The truth's samples are fixed per run, so TruthMode keeps TrackAt's search and weights
+    and applies them to every parameter step's track: jittered ticks, samples between, on and
+    beyond them, one column and three, several tracks through one TrackAt."""
+    from odo_tools.gap.model import TrackAt
+
+    rng = np.random.default_rng(3)
+    t = np.cumsum(rng.uniform(0.018, 0.022, ticks))
+    tq = np.concatenate([[t[0] - 0.1], rng.uniform(t[0], t[-1], 500), t[::7], [t[-1] + 0.1]])
+    at = TrackAt(tq, t)
+    for _ in range(3):
+        y = np.cumsum(rng.normal(0.0, 1.0, (ticks, 3)), axis=0)
+        assert np.array_equal(at(y), _track_at_plain(tq, t, y))
+        assert np.array_equal(at(y[:, 2]), _track_at_plain(tq, t, y[:, 2]))
+    y = rng.normal(0.0, 1.0, (ticks, 3))
+    lin = np.stack([np.interp(tq, t, y[:, c]) for c in range(3)], axis=-1)
+    assert np.array_equal(TrackAt(tq, t, at_ticks=True)(y), lin)
+
+
+def test_no_drive_effect_is_fitted_on_a_passive_trailer() -> None:
+    """A set's trailer rolls passively: slip, skid and scrub on it are the nominal model
+    (model.floor_travel, test_track_cache_answers_each_truck_for_its_own_parameters), so they
+    are not offered as its own hypotheses; its geometry is, and a clapper's driven truck B
+    keeps them all."""
+    from odo_tools.gap import hypotheses
+
+    singles = hypotheses.singles("truth", "set")
+    fams = {h.families[0] for h in singles}
+    assert {"slip", "scrub", "ed"} <= fams
+    onB = {h.families[0] for h in singles if hypotheses.on_truck(h, "B", (True, False))}
+    assert "ed" in onB and not onB & {"slip", "skid", "scrub"}
+    onA = {h.families[0] for h in singles if hypotheses.on_truck(h, "A", (True, False))}
+    assert {"slip", "scrub", "ed"} <= onA
+    clapB = {h.families[0] for h in singles if hypotheses.on_truck(h, "B", (True, True))}
+    assert {"slip", "scrub", "ed"} <= clapB

@@ -234,7 +234,11 @@ def _lever_with_skid(ds: Dataset, keys: list[str], best: _Levers) -> _Levers:
     preliminary fit; the reading whose tracks (and linkage) fit best by quasi-BIC, `best` (found
     without a skid) where none is better."""
     kc = "skid@cornering.deg_per_m_s2"
-    each = [f"{kc}.{t}" for t in "AB"] if ds.robot.n_trucks > 1 else [kc]
+    # on the driven trucks only: a set's trailer rolls passively and a skid there is the fit
+    # without one (model.floor_travel), which cost a set two of its three readings for nothing
+    each = [kc]
+    if ds.robot.n_trucks > 1:
+        each = [f"{kc}.{'AB'[t]}" for t, drive in enumerate(ds.prs[0].driven) if drive]
 
     def deviance(r: _Levers) -> tuple[float, float, int]:
         return Problem("truth", r.items, best.sigma).deviance(r.P)  # one noise scale
@@ -423,7 +427,11 @@ def rank(ds: Dataset, sel: Selection, progress: Progress = None) -> Ranking:
         proposals[f"on truck {scoped}"] = (
             f"{max(trucks):.0%} of the excess misfit lies in truck {scoped}'s channels"
         )
-        hyps += [v for v in (hypotheses.on_truck(h, scoped) for h in list(hyps)) if v is not None]
+        hyps += [
+            v
+            for v in (hypotheses.on_truck(h, scoped, ds.prs[0].driven) for h in list(hyps))
+            if v is not None
+        ]
     elif trucks:
         # the misfit leans to one truck without living there (a linked truck's channels share
         # what one truck's geometry does: an Es on the trailer of a set left 62 %, an Eb 53 %):
@@ -432,7 +440,11 @@ def rank(ds: Dataset, sel: Selection, progress: Progress = None) -> Ranking:
         # tracks 27-113 mm off and A's within 2 mm while the windows leaned to A, and the verdict
         # was "unexplained" at 11.6 x the background (2841 case 58; a set's, 2841 case 19: 133 x)
         geo = [h for h in hyps if len(h.laws) == 1 and h.families[0] in THIRDS]
-        hyps += [v for v in (hypotheses.on_truck(h, t) for t in "AB" for h in geo) if v is not None]
+        hyps += [
+            v
+            for v in (hypotheses.on_truck(h, t, ds.prs[0].driven) for t in "AB" for h in geo)
+            if v is not None
+        ]
     singles = par.each(
         [functools.partial(fit_hypothesis, h, prob, fprs, sig_head) for h in hyps],
         [f"fitting {h.name}" for h in hyps],
@@ -801,7 +813,7 @@ def _track_refit(ds: Dataset, sel: Selection, rk: Ranking, progress: Progress = 
     # clappers and sets of 2821-2851 with twice the added fits
     if ds.robot.n_trucks == 2:
         t = tp.excess_truck({})
-        singles += [v for v in (hypotheses.on_truck(h, t) for h in singles) if v]
+        singles += [v for v in (hypotheses.on_truck(h, t, ds.prs[0].driven) for h in singles) if v]
     fits = par.each(
         [functools.partial(_track_fit, h, tp, rk.prob, warm) for h in singles],
         [f"fitting {h.name} to the accumulated track" for h in singles],

@@ -10,9 +10,11 @@ the family (the physics) and reports the law that fitted. Pairs join two familie
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, replace
 
 from . import catalog
+from .model import DRIVE_ONLY
 
 # free parameters of each catalog effect under its catalog law (others stay at their defaults)
 CATALOG_FREE = {
@@ -241,12 +243,20 @@ def other_laws(family: str, mode: str, vehicle: str) -> list[Hypothesis]:
     return [Hypothesis((law,)) for law in laws]
 
 
-def on_truck(h: Hypothesis, truck: str) -> Hypothesis | None:
-    """A single hypothesis of a truck-scoped effect restricted to one truck (None otherwise)."""
+def on_truck(h: Hypothesis, truck: str, driven: Sequence[bool] = (True, True)) -> Hypothesis | None:
+    """A single hypothesis of a truck-scoped effect restricted to one truck (None otherwise, and
+    for a drive effect on a truck that rolls passively, where it is the nominal model:
+    model.DRIVE_ONLY; `driven` per truck, model.Prepared.driven)."""
     if len(h.laws) != 1 or h.has_bumps:
         return None
     law = h.laws[0]
     if law.truck is not None or catalog.effects()[law.family]["scope"] != "truck":
+        return None
+    if (
+        not driven["AB".index(truck)]
+        and law.params
+        and all(p.startswith(DRIVE_ONLY) for p in law.params)
+    ):
         return None
     if law.family == "roughness":  # one floor under both trucks
         return None

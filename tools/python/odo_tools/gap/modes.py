@@ -20,12 +20,12 @@ import numpy as np
 from .io import Robot
 from .model import (
     Prepared,
+    TrackAt,
     dead_reckon,
     interp_track,
     link_bias,
     rough_moments,
     rough_window_var,
-    track_at,
     truck_view,
     wrap_rad,
 )
@@ -234,6 +234,10 @@ class TruthMode:
         kt = np.clip(np.searchsorted(pr.t, self.tt), 1, pr.t.size - 1)
         gap = np.minimum(np.abs(self.tt - pr.t[kt - 1]), np.abs(self.tt - pr.t[kt]))
         self.exact = bool(np.all(gap <= 1e-6))
+        # the model at the truth's samples and at the windows' ends (model.TrackAt): between
+        # ticks a cubic through them; a truth taken at the ticks needs no interpolation
+        self._at_all = TrackAt(self.tt, pr.t, self.exact)
+        self._at_ends = TrackAt(self.tt[self._ends], pr.t, self.exact)
         lg = pr.run.log
         self.has_link = self.tlink is not None and lg.alpha_deg is not None
         bits = robot.linkage.get("rotary_bits", robot.trailer.get("rotary_bits", 10))
@@ -293,15 +297,8 @@ class TruthMode:
             ]
         )  # (trucks, nwin)
 
-    def _at(self, tq: np.ndarray, p: np.ndarray) -> np.ndarray:
-        """The model's (x, y, heading) track p at truth times tq: between ticks through
-        model.track_at; a truth taken at the ticks themselves needs no interpolation (the same
-        numbers, np.interp's speed)."""
-        return (interp_track if self.exact else track_at)(tq, self.pr.t, p[:, :3])
-
     def model_pose(self, P: dict, truck: int) -> np.ndarray:
-        p = dead_reckon(self.pr, P, truck)
-        return self._at(self.tt, p)
+        return self._at_all(dead_reckon(self.pr, P, truck)[:, :3])
 
     def channels(self) -> list[str]:
         ch = []
@@ -331,10 +328,8 @@ class TruthMode:
 
     def residuals(self, P: dict) -> np.ndarray:
         cols = []
-        te = self.tt[self._ends]
         for t in range(self.trucks):
-            p = dead_reckon(self.pr, P, t)
-            mp = self._at(te, p)
+            mp = self._at_ends(dead_reckon(self.pr, P, t)[:, :3])
             m = _body_inc(mp, self._ie, self._je)
             cols.append(self.tinc[t] - m)
         if self.has_link:
