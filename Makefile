@@ -36,8 +36,8 @@ bench: release ## print benchmark figures as JSON (-O2 build: build/release/bin/
 bench-target: release cm4 ## Cortex-M4 figures as JSON: instructions per tick (emulated), flash, RAM, stack
 	@.venv/bin/odo-bench-target --build-dir build/release --cm4-dir build/cm4
 
-bench-gap: build ## odo-gap diagnosis time on dev cases as JSON; REF=<git rev> adds the ratio against it, CASES=S:K,... other cases
-	@.venv/bin/python -m odo_tools.gap.bench $(if $(REF),--ref $(REF)) $(if $(CASES),--cases $(CASES))
+bench-gap: build ## odo-gap diagnosis time on dev cases as JSON; REF=<git rev> adds the ratio against it, CASES=S:K,... other cases, WORLD=sim the simulator's
+	@.venv/bin/python -m odo_tools.gap.bench $(if $(REF),--ref $(REF)) $(if $(CASES),--cases $(CASES)) $(if $(WORLD),--world $(WORLD))
 
 flash: cm4 ## program the image with openocd, never its parameter sector (odo-flash code)
 	@.venv/bin/odo-flash code --image build/cm4/bin/odo_image.elf
