@@ -165,3 +165,27 @@ def test_traction_slip_the_phases_do_not_propose_is_still_tried(tmp_path: Path) 
     assert a == pytest.approx(c["true"]["effects"]["slip"]["a_lim_m_s2"], rel=0.05)
     h = rep["heldout"]
     assert h["ratio_after"] < 0.25 * h["ratio_before"]
+
+
+def test_traction_limit_is_started_below_the_runs_demand(tmp_path: Path) -> None:
+    """Independent world, seed 2981 case 24 (traced after that seed was measured): a LabMate
+    whose floor speed changes at most 0.74 m/s^2, while its counts never ask the centre for more
+    than 1.9 m/s^2. The traction law started at its catalog 2 m/s^2, where the limit touched no
+    tick: no gradient, and from the return errors alone the slip went "unexplained" at 21 x the
+    background with Ed's growth law best. Started below the hardest demand the counts show
+    (fit.GRIP_LIMITS, as the friction circle's skid), the return errors name slip under the
+    traction law."""
+    from odo_tools.gap.diagnose import diagnose, load
+    from odo_tools.gap.model import accel_demand
+
+    real = tmp_path / "real"
+    c = indep_case(2981, 24, real, "labmate", {"slip": "traction"})
+    ds = load(real, real / "robot.json", "returns")
+    assert accel_demand(ds.prs, 100.0) < 2.0  # the catalog start sat above every demand
+    rep = diagnose(real, real / "robot.json", mode="returns").to_dict()
+    v = rep["verdict"]
+    assert (v["effect"], v["best_hypothesis"]) == ("slip", "slip@traction")
+    h = rep["heldout"]
+    assert h["ratio_after"] < 0.25 * h["ratio_before"]
+    a = v["params"]["slip@traction.a_max_m_s2"]
+    assert a == pytest.approx(c["true"]["effects"]["slip"]["a_lim_m_s2"], rel=0.25)
