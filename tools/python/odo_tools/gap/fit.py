@@ -328,7 +328,8 @@ def evaluate(
 
 
 # limits (m/s^2) of the floor's grip: the friction circle's skid, traction and motor slip
-GRIP_LIMITS = ("skid@friction.a_lim_m_s2", "slip@traction.a_max_m_s2", "slip@motor.a_max_m_s2")
+FRICTION_LIMIT = "skid@friction.a_lim_m_s2"
+GRIP_LIMITS = (FRICTION_LIMIT, "slip@traction.a_max_m_s2", "slip@motor.a_max_m_s2")
 
 
 def fit_hypothesis(
@@ -373,8 +374,9 @@ def fit_hypothesis(
         from .model import accel_demand
 
         peak = accel_demand(prs)
-        lim = [k for k in lim if k.startswith(GRIP_LIMITS[0]) or bounds(k)[2] >= peak]
-        starts += [{k: f * peak for k in lim} for f in (0.8, 0.5, 0.25)] if lim else []
+        lim = [k for k in lim if k.startswith(FRICTION_LIMIT) or bounds(k)[2] >= peak]
+        if lim:
+            starts += [{k: f * peak for k in lim} for f in (0.8, 0.5, 0.25)]
     if not hyp.has_bumps:
         P, se = fit_params(prob, keys, fixed, warm=warm, bnd=bnd, starts=starts)
         return evaluate(prob, hyp.name, P, se, len(keys), hyp=hyp)
