@@ -65,12 +65,7 @@ def estimate(prs: list[Prepared], trucks: int) -> tuple[Instrument, list[str]]:
             inst.heading_offset_rad[t] = o
     for _ in range(2):
         notes = []
-        found = {
-            pr.run.name: latency(
-                pr, lever=inst.lever_mm[0], heading_offset=inst.heading_offset_rad[0]
-            )
-            for pr in with_truth
-        }
+        found = {pr.run.name: latency(pr, inst) for pr in with_truth}
         inst.latency_s.update(session_latencies(with_truth, found))
         for t in range(trucks):
             o, se, n = lever_arm(with_truth, t, inst)
@@ -184,17 +179,7 @@ def under(inst: Instrument, prs: list[Prepared], P: dict) -> Instrument:
     OptiOdom squares' ~25 ms, half their 50 ms tick, read as the truth's noise otherwise."""
     out = inst.copy()
     with_truth = [pr for pr in prs if pr.run.truth is not None]
-    found = {
-        pr.run.name: latency(
-            pr,
-            0,
-            P,
-            min_tick=0.0,
-            lever=inst.lever_mm[0],
-            heading_offset=inst.heading_offset_rad[0],
-        )
-        for pr in with_truth
-    }
+    found = {pr.run.name: latency(pr, inst, P) for pr in with_truth}
     # a run whose track does not fix its shift keeps the clock the scan found under slip
     # (diagnose._slip_not_latency), rather than none
     out.latency_s.update(session_latencies(with_truth, found, out.clock_s or 0.0))
@@ -231,58 +216,46 @@ def _mad(x: np.ndarray) -> float:
 
 def latency(
     pr: Prepared,
-    truck: int = 0,
+    inst: Instrument | None = None,
     P: dict | None = None,
     min_tick: float = 0.0,
-    lever: tuple[float, float] = (0.0, 0.0),
-    heading_offset: float = 0.0,
 ) -> float | None:
     """The shift (s) that best lines the truth's heading (times half the wheelbase) and travel
-    increments over 0.4 s windows up with the model's (P, nominal by default); None when no
-    shift helps beyond chance (Delta chi^2 25: the session's other runs decide,
+    increments over 0.4 s windows up with the model's (P, nominal by default), on every truck
+    the truth tracks at once (each in units of its own noise; markers and lever arms from
+    `inst`): the clock is the rig's, one for all markers, and a truck with coarse counts reads
+    it poorly (the independent world's set with 7 mm counts on its tractor read 23-40 ms for a
+    31 ms clock on nine runs; its trailer, 0.07 mm counts, 30.4-31.8 ms). None when no shift
+    helps beyond chance (Delta chi^2 25: the session's other runs decide,
     `session_latencies`), 0 when it is shorter than `min_tick` count ticks. Windows, not the
     accumulated track: a strong effect (a scrub, slip) leaves a track misfit that a time shift
     of 0.2 s lowers too (tried: the blind check's simulator, which has no latency, read 0.2 s)."""
     tr = pr.run.truth
-    p = dead_reckon(pr, P or {}, truck)
-    tt = tr.t_s
-    i, j = _windows(tt)
+    i, j = _windows(tr.t_s)
     if i.size < 10:
         return None
-    tp = to_centre(tr.pose[:, truck : truck + 1], [lever], [heading_offset])[:, 0]
-    half_b = 0.5 * pr.b[truck]
-    dth = tp[j, 2] - tp[i, 2]
-    c, s_ = np.cos(tp[i, 2]), np.sin(tp[i, 2])
-    dlong = c * (tp[j, 0] - tp[i, 0]) + s_ * (tp[j, 1] - tp[i, 1])
-
-    # the model is needed at the windows' ends only (np.interp is pointwise: same numbers)
-    ends = np.union1d(i, j)
-    ie, je = np.searchsorted(ends, i), np.searchsorted(ends, j)
-    t_ends = tt[ends]
-
-    def resid(L: np.ndarray) -> np.ndarray:
-        """(shifts, 2 x windows): the residuals under every shift L (s) at once."""
-        tm = t_ends[None, :] - L[:, None]
-        ok = (tm[:, ie] >= pr.t[0]) & (tm[:, je] <= pr.t[-1])
-        mx, my, mth = np.moveaxis(track_at(tm, pr.t, p[:, :3]), -1, 0)
-        cm, sm = np.cos(mth[:, ie]), np.sin(mth[:, ie])
-        ml = cm * (mx[:, je] - mx[:, ie]) + sm * (my[:, je] - my[:, ie])
-        r = np.concatenate([(dth - (mth[:, je] - mth[:, ie])) * half_b, dlong - ml], axis=1)
-        return np.where(np.concatenate([ok, ok], axis=1), r, np.nan)
-
     grid = np.arange(-LATENCY_MAX_S, LATENCY_MAX_S + 1e-9, LATENCY_STEP_S)
-    R = resid(grid)
-    usable = np.all(np.isfinite(R), axis=0)
-    if usable.sum() < 10:
-        return None
-    R = R[:, usable]
-    cost = np.sum(R * R, axis=1)
+    trucks = range(min(tr.pose.shape[1], len(pr.b)))
+    Rs = [_shift_residuals(pr, t, P, grid, i, j, inst) for t in trucks]
+    cost = np.zeros(grid.size)
     k0 = int(np.argmin(np.abs(grid)))
+    n = 0
+    for R in Rs:
+        R = R[:, np.all(np.isfinite(R), axis=0)]  # the same windows under every shift
+        if R.shape[1] < 10:
+            continue
+        c = np.sum(R * R, axis=1)
+        s = _mad(np.diff(R[int(np.argmin(c))])) / math.sqrt(2.0)
+        if not s > 0:
+            continue
+        cost += c / (s * s)
+        n += 1
+    if n == 0:
+        return None
     k = int(np.argmin(cost))
     if k in (0, grid.size - 1):  # no minimum inside the grid
         return None
-    s = _mad(np.diff(R[k])) / math.sqrt(2.0)
-    if not s > 0 or (cost[k0] - cost[k]) / (s * s) < LATENCY_DCHI2:
+    if cost[k0] - cost[k] < LATENCY_DCHI2:
         return None
     L = float(grid[k])
     if abs(L) < min_tick * float(np.median(pr.dt)):
@@ -292,6 +265,40 @@ def latency(
     if den > 0:
         L += float(0.5 * (c0 - c2) / den * LATENCY_STEP_S)
     return L
+
+
+def _shift_residuals(
+    pr: Prepared,
+    truck: int,
+    P: dict | None,
+    grid: np.ndarray,
+    i: np.ndarray,
+    j: np.ndarray,
+    inst: Instrument | None,
+) -> np.ndarray:
+    """(shifts, 2 x windows): truck's window residuals (heading x b/2, travel) under every shift
+    of the grid at once; NaN where a shifted window leaves the counts."""
+    tr = pr.run.truth
+    p = dead_reckon(pr, P or {}, truck)
+    tt = tr.t_s
+    lever = inst.lever_mm[truck] if inst is not None else (0.0, 0.0)
+    off = inst.heading_offset_rad[truck] if inst is not None else 0.0
+    tp = to_centre(tr.pose[:, truck : truck + 1], [lever], [off])[:, 0]
+    half_b = 0.5 * pr.b[truck]
+    dth = tp[j, 2] - tp[i, 2]
+    c, s_ = np.cos(tp[i, 2]), np.sin(tp[i, 2])
+    dlong = c * (tp[j, 0] - tp[i, 0]) + s_ * (tp[j, 1] - tp[i, 1])
+
+    # the model is needed at the windows' ends only (np.interp is pointwise: same numbers)
+    ends = np.union1d(i, j)
+    ie, je = np.searchsorted(ends, i), np.searchsorted(ends, j)
+    tm = tt[ends][None, :] - grid[:, None]
+    ok = (tm[:, ie] >= pr.t[0]) & (tm[:, je] <= pr.t[-1])
+    mx, my, mth = np.moveaxis(track_at(tm, pr.t, p[:, :3]), -1, 0)
+    cm, sm = np.cos(mth[:, ie]), np.sin(mth[:, ie])
+    ml = cm * (mx[:, je] - mx[:, ie]) + sm * (my[:, je] - my[:, ie])
+    r = np.concatenate([(dth - (mth[:, je] - mth[:, ie])) * half_b, dlong - ml], axis=1)
+    return np.where(np.concatenate([ok, ok], axis=1), r, np.nan)
 
 
 CLOCK_OUTLIERS = 0.25  # at most this share of a session's runs (at least one) may disagree
@@ -476,9 +483,7 @@ def clock_rate(prs: list[Prepared], inst: Instrument, P: dict | None = None) -> 
             link = None if tr.link is None else tr.link[a:b]
             third = replace(tr, t_s=tr.t_s[a:b], pose=tr.pose[a:b], link=link)
             part = replace(pr, run=replace(pr.run, truth=third))
-            L = latency(
-                part, 0, P, lever=inst.lever_mm[0], heading_offset=inst.heading_offset_rad[0]
-            )
+            L = latency(part, inst, P)
             got.append((L, float(np.mean(tr.t_s[a:b]))))
         (l0, t0), (l1, t1) = got
         if l0 is not None and l1 is not None and t1 > t0:
