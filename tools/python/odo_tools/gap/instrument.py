@@ -7,8 +7,9 @@ per run). Both move the truth in ways no catalog effect should be asked to expla
 - **Lever arm** (per truck, x forward and y left of the axle centre): on a turn on the spot the
   centre stays put while the marker circles it, so the marker's increments there are
   (R(dtheta) - I) o, linear in o, with the measured heading change. Fitted on those windows only
-  (on arcs an Eb or a scrub misfit is correlated with it); without spot turns it is left at zero
-  and the report says so.
+  (on arcs an Eb or a scrub misfit is correlated with it); without spot turns it is fitted on
+  arcs of both directions together with the robot's geometry (`on_arcs`), and the report says
+  so.
 - **Latency** (per run): the time shift that best lines the truth's heading and travel
   increments up with the nominal model's, kept where it lowers the misfit beyond chance
   (Delta chi^2 25); a run that does not fix it (a spin) takes its session's median. A session
@@ -195,7 +196,7 @@ def on_arcs(
     them sideways, a sideways one along - with arcs of both directions neither is a scale error
     or a skid. Without it the independent world's 30 mm markers read as roughness at its bound."""
     with_truth = [pr for pr in prs if pr.run.truth is not None]
-    return lever_arm(with_truth, truck, inst, P, arcs=True)
+    return lever_arm(with_truth, truck, inst, P, arcs=True, joint=True)
 
 
 def significant(o, se) -> bool:
@@ -383,11 +384,27 @@ def session_latencies(
 
 
 def lever_arm(
-    prs: list[Prepared], truck: int, inst: Instrument, P: dict | None = None, arcs: bool = False
+    prs: list[Prepared],
+    truck: int,
+    inst: Instrument,
+    P: dict | None = None,
+    arcs: bool = False,
+    joint: bool = False,
 ) -> tuple[tuple[float, float] | None, tuple[float, float], int]:
     """Least squares of the marker's increments on spot turns (or, with `arcs`, on every window
-    that turns at least TURN_RAD, the model under P): ((ox, oy), (se_x, se_y), windows)."""
-    A_rows, r_rows = [], []
+    that turns at least TURN_RAD, the model under P): ((ox, oy), (se_x, se_y), windows).
+    `joint` (arcs, P without a skid): P's geometry moves with the lever arm in the same least
+    squares, linearised about P (`_geometry_columns`), with the truth's heading increments as
+    rows that pin it: on an arc at one speed a marker behind the axle and a wheelbase error move
+    the increments alike, and a geometry fit alternating with the lever arm's closed the
+    difference by ~40 % a round (dev seed 2771 case 53: after the two rounds both markers of a
+    clapper with no effect read 8 mm ahead of where they sit, and its held-out tracks at 5 x the
+    background took a cornering skid)."""
+    P = P or {}
+    keys = []
+    if joint and arcs and not any(k.startswith("skid") for k in P):
+        keys = [k for k in P if k.split(".")[0] in JOINT_GEOMETRY]
+    A_rows, r_rows, h_rows, rh_rows = [], [], [], []
     for pr in prs:
         tr = pr.run.truth
         if truck >= tr.pose.shape[1]:
@@ -398,7 +415,7 @@ def lever_arm(
         i, j = i[ok], j[ok]
         if i.size == 0:
             continue
-        p = dead_reckon(pr, P or {}, truck)
+        p = dead_reckon(pr, P, truck)
         m = track_at(tt, pr.t, p[:, :3])
         off = inst.heading_offset_rad[truck] if truck < len(inst.heading_offset_rad) else 0.0
         inc_t = _body_inc(to_centre(tr.pose[:, truck : truck + 1], [(0.0, 0.0)], [off])[:, 0], i, j)
@@ -419,14 +436,23 @@ def lever_arm(
             [np.column_stack([c - 1.0, -s_]), np.column_stack([s_, c - 1.0])], axis=1
         ).reshape(-1, 2)
         r = (inc_t[spot, :2] - inc_m[spot, :2]).reshape(-1)
+        if keys:
+            J = _geometry_columns(pr, P, keys, truck, tt, i[spot], j[spot], inc_m[spot])
+            A = np.hstack([A, J[:, :2, :].reshape(-1, len(keys))])
+            h_rows.append(np.hstack([np.zeros((J.shape[0], 2)), J[:, 2, :]]))
+            rh_rows.append(inc_t[spot, 2] - inc_m[spot, 2])
         A_rows.append(A)
         r_rows.append(r)
     n = sum(a.shape[0] // 2 for a in A_rows)
     if n < LEVER_MIN_WINDOWS:
         return None, (0.0, 0.0), n
     A, r = np.vstack(A_rows), np.concatenate(r_rows)
+    if keys:  # the heading rows pin the geometry, in the position rows' units
+        H, rh = np.vstack(h_rows), np.concatenate(rh_rows)
+        g = max(_mad(r), 1e-6) / max(_mad(rh), 1e-9)
+        A, r = np.vstack([A, g * H]), np.concatenate([r, g * rh])
     w = np.ones(r.size)
-    o = np.zeros(2)
+    o = np.zeros(A.shape[1])
     for _ in range(5):  # Huber-weighted: a bump on a turn must not pull the marker around
         Aw = A * w[:, None]
         o = np.linalg.lstsq(Aw, r * w, rcond=None)[0]
@@ -434,10 +460,41 @@ def lever_arm(
         s = max(_mad(e), 1e-6)
         w = np.sqrt(np.minimum(1.0, 1.5 * s / np.maximum(np.abs(e), 1e-12)))
     e = r - A @ o
-    s2 = float(np.sum((w * e) ** 2) / max(r.size - 2, 1))
+    s2 = float(np.sum((w * e) ** 2) / max(r.size - A.shape[1], 1))
     cov = np.linalg.pinv((A * w[:, None]).T @ (A * w[:, None])) * s2
     se = (float(math.sqrt(max(cov[0, 0], 0.0))), float(math.sqrt(max(cov[1, 1], 0.0))))
     return (float(o[0]), float(o[1])), se, n
+
+
+# the geometry that moves with the lever arm (`lever_arm(joint=True)`), in the preliminary fit
+# without a skid only. A cornering skid moves a truck sideways on an arc just as a marker ahead
+# of the axle does: in one least squares with it the marker of a set's tractor with no skid came
+# out 30 +- 9 mm ahead (dev seed 2821 case 9), and with the geometry alone beside a fixed skid a
+# skidding clapper truck's marker 1.0 mm behind its axle (dev 2761 case 44, 0 with the rounds
+# alone); the skid's readings are told apart by their fit (diagnose._lever_with_skid)
+JOINT_GEOMETRY = ("ed", "eb", "es", "scrub")
+GEOMETRY_STEP = 1e-4  # finite-difference step of a geometry parameter (relative, at least absolute)
+
+
+def _geometry_columns(
+    pr: Prepared,
+    P: dict,
+    keys: list[str],
+    truck: int,
+    tt: np.ndarray,
+    i: np.ndarray,
+    j: np.ndarray,
+    inc0: np.ndarray,
+) -> np.ndarray:
+    """(windows, 3, keys): how the model's body-frame increments (x, y, heading) over the
+    windows (i, j) move per unit of each geometry parameter of P, by forward differences."""
+    out = np.zeros((i.size, 3, len(keys)))
+    for k, key in enumerate(keys):
+        h = GEOMETRY_STEP * max(1.0, abs(P[key]))
+        p = dead_reckon(pr, {**P, key: P[key] + h}, truck)
+        m = track_at(tt, pr.t, p[:, :3])
+        out[:, :, k] = (_body_inc(m, i, j) - inc0) / h
+    return out
 
 
 CLOCK_RATE_MIN_PPM = 200.0  # a truth clock drifting less than this is left alone
