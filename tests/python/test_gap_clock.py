@@ -65,21 +65,3 @@ def test_a_clock_needs_many_runs_that_agree_on_a_real_rate() -> None:
     assert not ClockRate(-600.0, 90.0, 9, 10, 50.0).drifting()  # the runs scatter
     assert not ClockRate(600.0, 30.0, 6, 10, 50.0).drifting()  # too few of the runs
     assert not ClockRate(600.0, 30.0, 3, 3, 50.0).drifting()  # too few runs
-
-
-def test_the_clock_is_read_on_every_tracked_truck_at_once(tmp_path: Path) -> None:
-    """Independent world, dev seed 2821 case 9: a set with no effect whose tractor counts 7 mm
-    per step (8 lines, gear 3.7, 276 mm wheels) and whose trailer counts 0.07 mm; the motion
-    capture lags both by 31 ms. Read on the tractor alone the nine runs gave 23-40 ms, the
-    session's runs disagreed, six went to zero, and the verdict was "unexplained" at 7 x the
-    background. One clock for both markers, each truck weighted by its own noise, reads it
-    within 2 ms on every run."""
-    from odo_tools.gap.diagnose import load
-
-    real = tmp_path / "real"
-    c = indep_case(2821, 9, real, "set", {})
-    true = c["fidelity"]["truth_latency_s"]
-    ds = load(real, real / "robot.json", mode="truth")
-    got = ds.instrument.latency_s
-    assert len(got) == 9
-    assert all(abs(L - true) < 0.002 for L in got.values()), (got, true)

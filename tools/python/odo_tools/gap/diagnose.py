@@ -300,14 +300,19 @@ def _lever_rounds(ds: Dataset, keys: list[str]) -> _Levers:
                 continue
             inst.lever_se_mm[t] = se
             inst.lever_mm[t] = o if instrument.significant(o, se) else (0.0, 0.0)
+            if t == 0:  # the latency again, with this lever arm
+                wt = [pr for pr in ds.prs if pr.run.truth is not None]
+                found = {
+                    pr.run.name: instrument.latency(
+                        pr, lever=inst.lever_mm[0], heading_offset=inst.heading_offset_rad[0]
+                    )
+                    for pr in wt
+                }
+                inst.latency_s.update(instrument.session_latencies(wt, found))
             notes.append(
                 f"truck {'AB'[t]}: no turns on the spot: lever arm from {n} windows on arcs, "
                 f"under a preliminary fit of {basis}"
             )
-        if notes:  # the latency again, with these lever arms
-            wt = [pr for pr in ds.prs if pr.run.truth is not None]
-            found = {pr.run.name: instrument.latency(pr, inst) for pr in wt}
-            inst.latency_s.update(instrument.session_latencies(wt, found))
         items = [TruthMode(pr, ds.robot, inst) for pr in ds.prs]
     return _Levers(inst, notes, items, prob.sigma, P)
 

@@ -7,9 +7,8 @@ per run). Both move the truth in ways no catalog effect should be asked to expla
 - **Lever arm** (per truck, x forward and y left of the axle centre): on a turn on the spot the
   centre stays put while the marker circles it, so the marker's increments there are
   (R(dtheta) - I) o, linear in o, with the measured heading change. Fitted on those windows only
-  (on arcs an Eb or a scrub misfit is correlated with it); without spot turns it is fitted on
-  arcs of both directions together with the robot's geometry (`on_arcs`), and the report says
-  so.
+  (on arcs an Eb or a scrub misfit is correlated with it); without spot turns it is left at zero
+  and the report says so.
 - **Latency** (per run): the time shift that best lines the truth's heading and travel
   increments up with the nominal model's, kept where it lowers the misfit beyond chance
   (Delta chi^2 25); a run that does not fix it (a spin) takes its session's median. A session
@@ -66,7 +65,12 @@ def estimate(prs: list[Prepared], trucks: int) -> tuple[Instrument, list[str]]:
             inst.heading_offset_rad[t] = o
     for _ in range(2):
         notes = []
-        found = {pr.run.name: latency(pr, inst) for pr in with_truth}
+        found = {
+            pr.run.name: latency(
+                pr, lever=inst.lever_mm[0], heading_offset=inst.heading_offset_rad[0]
+            )
+            for pr in with_truth
+        }
         inst.latency_s.update(session_latencies(with_truth, found))
         for t in range(trucks):
             o, se, n = lever_arm(with_truth, t, inst)
@@ -180,7 +184,17 @@ def under(inst: Instrument, prs: list[Prepared], P: dict) -> Instrument:
     OptiOdom squares' ~25 ms, half their 50 ms tick, read as the truth's noise otherwise."""
     out = inst.copy()
     with_truth = [pr for pr in prs if pr.run.truth is not None]
-    found = {pr.run.name: latency(pr, inst, P) for pr in with_truth}
+    found = {
+        pr.run.name: latency(
+            pr,
+            0,
+            P,
+            min_tick=0.0,
+            lever=inst.lever_mm[0],
+            heading_offset=inst.heading_offset_rad[0],
+        )
+        for pr in with_truth
+    }
     # a run whose track does not fix its shift keeps the clock the scan found under slip
     # (diagnose._slip_not_latency), rather than none
     out.latency_s.update(session_latencies(with_truth, found, out.clock_s or 0.0))
@@ -196,7 +210,7 @@ def on_arcs(
     them sideways, a sideways one along - with arcs of both directions neither is a scale error
     or a skid. Without it the independent world's 30 mm markers read as roughness at its bound."""
     with_truth = [pr for pr in prs if pr.run.truth is not None]
-    return lever_arm(with_truth, truck, inst, P, arcs=True, joint=True)
+    return lever_arm(with_truth, truck, inst, P, arcs=True)
 
 
 def significant(o, se) -> bool:
@@ -217,46 +231,58 @@ def _mad(x: np.ndarray) -> float:
 
 def latency(
     pr: Prepared,
-    inst: Instrument | None = None,
+    truck: int = 0,
     P: dict | None = None,
     min_tick: float = 0.0,
+    lever: tuple[float, float] = (0.0, 0.0),
+    heading_offset: float = 0.0,
 ) -> float | None:
     """The shift (s) that best lines the truth's heading (times half the wheelbase) and travel
-    increments over 0.4 s windows up with the model's (P, nominal by default), on every truck
-    the truth tracks at once (each in units of its own noise; markers and lever arms from
-    `inst`): the clock is the rig's, one for all markers, and a truck with coarse counts reads
-    it poorly (the independent world's set with 7 mm counts on its tractor read 23-40 ms for a
-    31 ms clock on nine runs; its trailer, 0.07 mm counts, 30.4-31.8 ms). None when no shift
-    helps beyond chance (Delta chi^2 25: the session's other runs decide,
+    increments over 0.4 s windows up with the model's (P, nominal by default); None when no
+    shift helps beyond chance (Delta chi^2 25: the session's other runs decide,
     `session_latencies`), 0 when it is shorter than `min_tick` count ticks. Windows, not the
     accumulated track: a strong effect (a scrub, slip) leaves a track misfit that a time shift
     of 0.2 s lowers too (tried: the blind check's simulator, which has no latency, read 0.2 s)."""
     tr = pr.run.truth
-    i, j = _windows(tr.t_s)
+    p = dead_reckon(pr, P or {}, truck)
+    tt = tr.t_s
+    i, j = _windows(tt)
     if i.size < 10:
         return None
+    tp = to_centre(tr.pose[:, truck : truck + 1], [lever], [heading_offset])[:, 0]
+    half_b = 0.5 * pr.b[truck]
+    dth = tp[j, 2] - tp[i, 2]
+    c, s_ = np.cos(tp[i, 2]), np.sin(tp[i, 2])
+    dlong = c * (tp[j, 0] - tp[i, 0]) + s_ * (tp[j, 1] - tp[i, 1])
+
+    # the model is needed at the windows' ends only (np.interp is pointwise: same numbers)
+    ends = np.union1d(i, j)
+    ie, je = np.searchsorted(ends, i), np.searchsorted(ends, j)
+    t_ends = tt[ends]
+
+    def resid(L: np.ndarray) -> np.ndarray:
+        """(shifts, 2 x windows): the residuals under every shift L (s) at once."""
+        tm = t_ends[None, :] - L[:, None]
+        ok = (tm[:, ie] >= pr.t[0]) & (tm[:, je] <= pr.t[-1])
+        mx, my, mth = np.moveaxis(track_at(tm, pr.t, p[:, :3]), -1, 0)
+        cm, sm = np.cos(mth[:, ie]), np.sin(mth[:, ie])
+        ml = cm * (mx[:, je] - mx[:, ie]) + sm * (my[:, je] - my[:, ie])
+        r = np.concatenate([(dth - (mth[:, je] - mth[:, ie])) * half_b, dlong - ml], axis=1)
+        return np.where(np.concatenate([ok, ok], axis=1), r, np.nan)
+
     grid = np.arange(-LATENCY_MAX_S, LATENCY_MAX_S + 1e-9, LATENCY_STEP_S)
-    trucks = range(min(tr.pose.shape[1], len(pr.b)))
-    Rs = [_shift_residuals(pr, t, P, grid, i, j, inst) for t in trucks]
-    cost = np.zeros(grid.size)
-    k0 = int(np.argmin(np.abs(grid)))
-    n = 0
-    for R in Rs:
-        R = R[:, np.all(np.isfinite(R), axis=0)]  # the same windows under every shift
-        if R.shape[1] < 10:
-            continue
-        c = np.sum(R * R, axis=1)
-        s = _mad(np.diff(R[int(np.argmin(c))])) / math.sqrt(2.0)
-        if not s > 0:
-            continue
-        cost += c / (s * s)
-        n += 1
-    if n == 0:
+    R = resid(grid)
+    usable = np.all(np.isfinite(R), axis=0)
+    if usable.sum() < 10:
         return None
+    R = R[:, usable]
+    cost = np.sum(R * R, axis=1)
+    k0 = int(np.argmin(np.abs(grid)))
     k = int(np.argmin(cost))
     if k in (0, grid.size - 1):  # no minimum inside the grid
         return None
-    if cost[k0] - cost[k] < LATENCY_DCHI2:
+    s = _mad(np.diff(R[k])) / math.sqrt(2.0)
+    if not s > 0 or (cost[k0] - cost[k]) / (s * s) < LATENCY_DCHI2:
         return None
     L = float(grid[k])
     if abs(L) < min_tick * float(np.median(pr.dt)):
@@ -266,40 +292,6 @@ def latency(
     if den > 0:
         L += float(0.5 * (c0 - c2) / den * LATENCY_STEP_S)
     return L
-
-
-def _shift_residuals(
-    pr: Prepared,
-    truck: int,
-    P: dict | None,
-    grid: np.ndarray,
-    i: np.ndarray,
-    j: np.ndarray,
-    inst: Instrument | None,
-) -> np.ndarray:
-    """(shifts, 2 x windows): truck's window residuals (heading x b/2, travel) under every shift
-    of the grid at once; NaN where a shifted window leaves the counts."""
-    tr = pr.run.truth
-    p = dead_reckon(pr, P or {}, truck)
-    tt = tr.t_s
-    lever = inst.lever_mm[truck] if inst is not None else (0.0, 0.0)
-    off = inst.heading_offset_rad[truck] if inst is not None else 0.0
-    tp = to_centre(tr.pose[:, truck : truck + 1], [lever], [off])[:, 0]
-    half_b = 0.5 * pr.b[truck]
-    dth = tp[j, 2] - tp[i, 2]
-    c, s_ = np.cos(tp[i, 2]), np.sin(tp[i, 2])
-    dlong = c * (tp[j, 0] - tp[i, 0]) + s_ * (tp[j, 1] - tp[i, 1])
-
-    # the model is needed at the windows' ends only (np.interp is pointwise: same numbers)
-    ends = np.union1d(i, j)
-    ie, je = np.searchsorted(ends, i), np.searchsorted(ends, j)
-    tm = tt[ends][None, :] - grid[:, None]
-    ok = (tm[:, ie] >= pr.t[0]) & (tm[:, je] <= pr.t[-1])
-    mx, my, mth = np.moveaxis(track_at(tm, pr.t, p[:, :3]), -1, 0)
-    cm, sm = np.cos(mth[:, ie]), np.sin(mth[:, ie])
-    ml = cm * (mx[:, je] - mx[:, ie]) + sm * (my[:, je] - my[:, ie])
-    r = np.concatenate([(dth - (mth[:, je] - mth[:, ie])) * half_b, dlong - ml], axis=1)
-    return np.where(np.concatenate([ok, ok], axis=1), r, np.nan)
 
 
 CLOCK_OUTLIERS = 0.25  # at most this share of a session's runs (at least one) may disagree
@@ -384,27 +376,11 @@ def session_latencies(
 
 
 def lever_arm(
-    prs: list[Prepared],
-    truck: int,
-    inst: Instrument,
-    P: dict | None = None,
-    arcs: bool = False,
-    joint: bool = False,
+    prs: list[Prepared], truck: int, inst: Instrument, P: dict | None = None, arcs: bool = False
 ) -> tuple[tuple[float, float] | None, tuple[float, float], int]:
     """Least squares of the marker's increments on spot turns (or, with `arcs`, on every window
-    that turns at least TURN_RAD, the model under P): ((ox, oy), (se_x, se_y), windows).
-    `joint` (arcs, P without a skid): P's geometry moves with the lever arm in the same least
-    squares, linearised about P (`_geometry_columns`), with the truth's heading increments as
-    rows that pin it: on an arc at one speed a marker behind the axle and a wheelbase error move
-    the increments alike, and a geometry fit alternating with the lever arm's closed the
-    difference by ~40 % a round (dev seed 2771 case 53: after the two rounds both markers of a
-    clapper with no effect read 8 mm ahead of where they sit, and its held-out tracks at 5 x the
-    background took a cornering skid)."""
-    P = P or {}
-    keys = []
-    if joint and arcs and not any(k.startswith("skid") for k in P):
-        keys = [k for k in P if k.split(".")[0] in JOINT_GEOMETRY]
-    A_rows, r_rows, h_rows, rh_rows = [], [], [], []
+    that turns at least TURN_RAD, the model under P): ((ox, oy), (se_x, se_y), windows)."""
+    A_rows, r_rows = [], []
     for pr in prs:
         tr = pr.run.truth
         if truck >= tr.pose.shape[1]:
@@ -415,7 +391,7 @@ def lever_arm(
         i, j = i[ok], j[ok]
         if i.size == 0:
             continue
-        p = dead_reckon(pr, P, truck)
+        p = dead_reckon(pr, P or {}, truck)
         m = track_at(tt, pr.t, p[:, :3])
         off = inst.heading_offset_rad[truck] if truck < len(inst.heading_offset_rad) else 0.0
         inc_t = _body_inc(to_centre(tr.pose[:, truck : truck + 1], [(0.0, 0.0)], [off])[:, 0], i, j)
@@ -436,23 +412,14 @@ def lever_arm(
             [np.column_stack([c - 1.0, -s_]), np.column_stack([s_, c - 1.0])], axis=1
         ).reshape(-1, 2)
         r = (inc_t[spot, :2] - inc_m[spot, :2]).reshape(-1)
-        if keys:
-            J = _geometry_columns(pr, P, keys, truck, tt, i[spot], j[spot], inc_m[spot])
-            A = np.hstack([A, J[:, :2, :].reshape(-1, len(keys))])
-            h_rows.append(np.hstack([np.zeros((J.shape[0], 2)), J[:, 2, :]]))
-            rh_rows.append(inc_t[spot, 2] - inc_m[spot, 2])
         A_rows.append(A)
         r_rows.append(r)
     n = sum(a.shape[0] // 2 for a in A_rows)
     if n < LEVER_MIN_WINDOWS:
         return None, (0.0, 0.0), n
     A, r = np.vstack(A_rows), np.concatenate(r_rows)
-    if keys:  # the heading rows pin the geometry, in the position rows' units
-        H, rh = np.vstack(h_rows), np.concatenate(rh_rows)
-        g = max(_mad(r), 1e-6) / max(_mad(rh), 1e-9)
-        A, r = np.vstack([A, g * H]), np.concatenate([r, g * rh])
     w = np.ones(r.size)
-    o = np.zeros(A.shape[1])
+    o = np.zeros(2)
     for _ in range(5):  # Huber-weighted: a bump on a turn must not pull the marker around
         Aw = A * w[:, None]
         o = np.linalg.lstsq(Aw, r * w, rcond=None)[0]
@@ -460,41 +427,10 @@ def lever_arm(
         s = max(_mad(e), 1e-6)
         w = np.sqrt(np.minimum(1.0, 1.5 * s / np.maximum(np.abs(e), 1e-12)))
     e = r - A @ o
-    s2 = float(np.sum((w * e) ** 2) / max(r.size - A.shape[1], 1))
+    s2 = float(np.sum((w * e) ** 2) / max(r.size - 2, 1))
     cov = np.linalg.pinv((A * w[:, None]).T @ (A * w[:, None])) * s2
     se = (float(math.sqrt(max(cov[0, 0], 0.0))), float(math.sqrt(max(cov[1, 1], 0.0))))
     return (float(o[0]), float(o[1])), se, n
-
-
-# the geometry that moves with the lever arm (`lever_arm(joint=True)`), in the preliminary fit
-# without a skid only. A cornering skid moves a truck sideways on an arc just as a marker ahead
-# of the axle does: in one least squares with it the marker of a set's tractor with no skid came
-# out 30 +- 9 mm ahead (dev seed 2821 case 9), and with the geometry alone beside a fixed skid a
-# skidding clapper truck's marker 1.0 mm behind its axle (dev 2761 case 44, 0 with the rounds
-# alone); the skid's readings are told apart by their fit (diagnose._lever_with_skid)
-JOINT_GEOMETRY = ("ed", "eb", "es", "scrub")
-GEOMETRY_STEP = 1e-4  # finite-difference step of a geometry parameter (relative, at least absolute)
-
-
-def _geometry_columns(
-    pr: Prepared,
-    P: dict,
-    keys: list[str],
-    truck: int,
-    tt: np.ndarray,
-    i: np.ndarray,
-    j: np.ndarray,
-    inc0: np.ndarray,
-) -> np.ndarray:
-    """(windows, 3, keys): how the model's body-frame increments (x, y, heading) over the
-    windows (i, j) move per unit of each geometry parameter of P, by forward differences."""
-    out = np.zeros((i.size, 3, len(keys)))
-    for k, key in enumerate(keys):
-        h = GEOMETRY_STEP * max(1.0, abs(P[key]))
-        p = dead_reckon(pr, {**P, key: P[key] + h}, truck)
-        m = track_at(tt, pr.t, p[:, :3])
-        out[:, :, k] = (_body_inc(m, i, j) - inc0) / h
-    return out
 
 
 CLOCK_RATE_MIN_PPM = 200.0  # a truth clock drifting less than this is left alone
@@ -540,7 +476,9 @@ def clock_rate(prs: list[Prepared], inst: Instrument, P: dict | None = None) -> 
             link = None if tr.link is None else tr.link[a:b]
             third = replace(tr, t_s=tr.t_s[a:b], pose=tr.pose[a:b], link=link)
             part = replace(pr, run=replace(pr.run, truth=third))
-            L = latency(part, inst, P)
+            L = latency(
+                part, 0, P, lever=inst.lever_mm[0], heading_offset=inst.heading_offset_rad[0]
+            )
             got.append((L, float(np.mean(tr.t_s[a:b]))))
         (l0, t0), (l1, t1) = got
         if l0 is not None and l1 is not None and t1 > t0:
