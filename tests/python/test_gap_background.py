@@ -438,6 +438,43 @@ def test_a_walk_along_the_track_alone_still_spreads_the_track(tmp_path: Path) ->
     np.testing.assert_allclose(v[:, 0] + v[:, 1], want, rtol=0.05, atol=ql * 50.0)
 
 
+def test_the_track_allowance_kept_per_run_follows_the_walk_and_the_floor_bumps(
+    tmp_path: Path,
+) -> None:
+    """Background.track_var is kept per run and truck (a track fit asks for it at every step,
+    and no parameter it moves acts on it), but it is computed again when what it reads changes:
+    the walk, or the floor bumps placed on the run (the nominal track crosses them). Each answer
+    is a fresh Background's, and is read-only, since every caller shares it."""
+    from odo_tools.gap.background import Background
+    from odo_tools.gap.io import discover, read_robot
+    from odo_tools.gap.model import prepare
+    from odo_tools.gap.modes import TruthMode
+
+    robot = read_robot(SRC / "host_sim/robots/labmate.json")
+    real = tmp_path / "real"
+    odo_sim("none.json", real, runs=1)
+    pr = prepare(discover(real, robot)[0], robot)
+    item = TruthMode(pr, robot)
+    bg = Background("truth", q_wheel=[3e-3], q_turn=[1e-3])
+    v = bg.track_var(item, 0)
+    assert bg.track_var(item, 0) is v  # kept
+    assert not v.flags.writeable
+    assert np.array_equal(v, Background("truth", q_wheel=[3e-3], q_turn=[1e-3]).track_var(item, 0))
+    bg.q_wheel = [6e-3]
+    w = bg.track_var(item, 0)
+    assert np.array_equal(w, Background("truth", q_wheel=[6e-3], q_turn=[1e-3]).track_var(item, 0))
+    assert not np.array_equal(w, v)
+    pr.bumps.append({"truck": 0, "wheel": 0, "s0": 0.3 * pr.S[-1, 0, 0], "h": 20.0})
+    try:
+        u = bg.track_var(item, 0)
+        fresh = Background("truth", q_wheel=[6e-3], q_turn=[1e-3]).track_var(item, 0)
+    finally:
+        pr.bumps.clear()
+    assert np.array_equal(u, fresh)
+    assert not np.array_equal(u, w)  # the bump turned the track: the cache must not serve w
+    assert bg.track_var(item, 0) is w
+
+
 def _runs(lat: list[float], tick: float = 0.04):
     from types import SimpleNamespace
 

@@ -198,3 +198,41 @@ def test_no_drive_effect_is_fitted_on_a_passive_trailer() -> None:
     assert {"slip", "scrub", "ed"} <= onA
     clapB = {h.families[0] for h in singles if hypotheses.on_truck(h, "B", (True, True))}
     assert {"slip", "scrub", "ed"} <= clapB
+
+
+def test_rate_ceiling_law_over_every_stretch_at_once_is_the_per_stretch_loop_bit_for_bit() -> None:
+    """model.count_loss_plateau adds the hidden travel of every saturated tick of both wheels
+    in one step (`_plateau_stretches` keeps them as flat arrays); the form it replaced looped
+    over the stretches, one numpy expression each."""
+    from odo_tools.gap.model import PLATEAU_SUB, PLATEAU_TOL, count_loss_plateau
+
+    rng = np.random.default_rng(11)
+    ds = _wheels(rng, 1200)
+    pr = _prepared(ds[:, None, :])
+    pr.dt = 0.02 + rng.uniform(0.0, 1e-4, ds.shape[0])
+    pr.t = np.concatenate([[0.0], np.cumsum(pr.dt)])
+    level = float(np.percentile(np.abs(ds) / pr.dt[:, None], 80))  # a fifth of the ticks saturate
+    for E, a in ((0.4 * level, 2.0), (3.0 * level, 0.3)):
+        P = {
+            "count_loss@plateau.level_mm_s": level,
+            "count_loss@plateau.excess_mm_s": E,
+            "count_loss@plateau.a_m_s2": a,
+        }
+        want = ds.copy()
+        sat = np.abs(ds) / pr.dt[:, None] >= level * (1.0 - PLATEAU_TOL)
+        f = (np.arange(PLATEAU_SUB) + 0.5) / PLATEAU_SUB
+        stretches = 0
+        for w in (0, 1):  # the form it replaced: one stretch at a time
+            m = np.concatenate([[False], sat[:, w], [False]]).astype(np.int8)
+            up, down = np.flatnonzero(np.diff(m) == 1), np.flatnonzero(np.diff(m) == -1)
+            for i0, i1 in zip(up, down, strict=True):
+                tau = pr.t[i0:i1, None] - pr.t[i0] + f[None, :] * pr.dt[i0:i1, None]
+                T, am = pr.t[i1] - pr.t[i0], a * 1e3
+                ex = np.minimum(np.minimum(am * tau, am * (T - tau)), E)
+                want[i0:i1, w] += np.sign(ds[i0:i1, w]) * ex.mean(axis=1) * pr.dt[i0:i1]
+                stretches += 1
+        assert stretches > 10  # stretches on both wheels: the comparison covers the flat layout
+        got = count_loss_plateau(pr, ds, 0, P)
+        assert np.array_equal(got, want), E
+        assert not np.array_equal(got, ds)  # the law adds travel: the comparison can fail
+        assert np.array_equal(count_loss_plateau(pr, ds, 0, P), got)  # served from the cache

@@ -506,34 +506,41 @@ def count_loss_plateau(pr: Prepared, ds: np.ndarray, truck: int, P: dict) -> np.
     if E <= 0.0:
         return ds
     out = ds.copy()
-    for w, i0, i1, tau, T, sg in _plateau_stretches(pr, truck, level):
+    st = _plateau_stretches(pr, truck, level)
+    if st is not None:  # every saturated tick of both wheels at once (they never overlap)
+        rows, cols, tau, T, sg, dt = st
         ex = np.minimum(np.minimum(a * tau, a * (T - tau)), E)
-        out[i0:i1, w] += sg * ex.mean(axis=1) * pr.dt[i0:i1]
+        out[rows, cols] += sg * ex.mean(axis=1) * dt
     return out
 
 
-def _plateau_stretches(pr: Prepared, truck: int, level: float) -> list[tuple]:
-    """Per stretch of a wheel's saturated ticks: (wheel, first tick, end tick, (ticks, sub-steps)
-    times since the stretch began, its length, the wheel's direction per tick). Independent of
-    the law's parameters, so a fit that moves them reuses it (cached per truck and ceiling)."""
+def _plateau_stretches(pr: Prepared, truck: int, level: float) -> tuple | None:
+    """Every saturated tick of a wheel, in stretches, as flat arrays: (tick, wheel, (ticks,
+    sub-steps) times since its stretch began, (ticks, 1) the stretch's length, the wheel's
+    direction, the tick's length); None where no tick saturates. Independent of the law's
+    parameters, so a fit that moves them reuses it (cached per truck and ceiling)."""
     key = ("plateau", truck, level)
-    hit = pr.slip_cache.get(key)
-    if hit is not None:
-        return hit
+    if key in pr.slip_cache:
+        return pr.slip_cache[key]
     t = pr.t
     raw = pr.ds[:, truck, :]
     sat = np.abs(raw) / pr.dt[:, None] >= level * (1.0 - PLATEAU_TOL)
     f = (np.arange(PLATEAU_SUB) + 0.5) / PLATEAU_SUB
-    out = []
+    parts: list[list[np.ndarray]] = [[] for _ in range(6)]
     for w in (0, 1):
         m = np.concatenate([[False], sat[:, w], [False]]).astype(np.int8)
         starts = np.flatnonzero(np.diff(m) == 1)
         ends = np.flatnonzero(np.diff(m) == -1)
         for i0, i1 in zip(starts, ends, strict=True):
             tau = t[i0:i1, None] - t[i0] + f[None, :] * pr.dt[i0:i1, None]
-            out.append((w, i0, i1, tau, t[i1] - t[i0], np.sign(raw[i0:i1, w])))
-    _cache_put(pr.slip_cache, key, out)
-    return out
+            n = i1 - i0
+            T = np.full((n, 1), t[i1] - t[i0])
+            got = (np.arange(i0, i1), np.full(n, w), tau, T, np.sign(raw[i0:i1, w]), pr.dt[i0:i1])
+            for p, g in zip(parts, got, strict=True):
+                p.append(g)
+    flat = tuple(np.concatenate(p) for p in parts) if parts[0] else None
+    _cache_put(pr.slip_cache, key, flat)
+    return flat
 
 
 SLIP_SUB_S = 0.001  # sub-step of the slip integral (the catalog's law acts per physics step)
