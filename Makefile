@@ -9,20 +9,22 @@ JOBS ?= $(shell nproc)
 help: ## list targets
 	@grep -E '^[a-z0-9-]+:.*## ' $(MAKEFILE_LIST) | awk -F':.*## ' '{printf "  make %-12s %s\n", $$1, $$2}'
 
+# installs and builds report on stderr: a bench target's stdout is its JSON alone
+# (make bench-gap > out.json)
 deps: ## install Debian packages and the pinned Python venv (.venv)
-	@bash tools/deps.sh
+	@bash tools/deps.sh >&2
 
 build: deps ## host Debug build with ASan+UBSan; CLIs in build/host/bin
 	@cmake --preset host >/dev/null
-	@cmake --build --preset host -j $(JOBS)
+	@cmake --build --preset host -j $(JOBS) >&2
 
 release: deps ## host -O2 build in build/release
 	@cmake --preset release >/dev/null
-	@cmake --build --preset release -j $(JOBS)
+	@cmake --build --preset release -j $(JOBS) >&2
 
 cm4: deps ## cross-compile firmware/ and link the Cortex-M4 image in build/cm4
 	@cmake --preset cm4 >/dev/null
-	@cmake --build --preset cm4 -j $(JOBS)
+	@cmake --build --preset cm4 -j $(JOBS) >&2
 
 test: build ## run every test (ctest: Unity, Check, pytest, lint, Cortex-M4 cross build)
 	@ctest --preset host -j $(JOBS)
