@@ -34,7 +34,6 @@ import numpy as np
 from .model import track_at
 from .modes import TruthMode
 
-
 TRACK_VAR_CACHE = 256  # runs x trucks x sets of floor bumps kept (each a few kB)
 
 
