@@ -96,15 +96,12 @@ class Background:
         the rest of the path sideways, and moves it back by d/2)."""
         qm, qt = self._q(truck)
         ql = self.q_long[truck] if truck < len(self.q_long) else 0.0
-        pr = item.pr
-        tw = item.tt[item.i]
-        n_out = tw.size
         # a floor that takes travel without turning the truck (the longitudinal walk alone)
         # still moves it along: the independent world's trailer on grains, 0.08 mm high under
         # 76 mm wheels, heading walk 0, lost 1-1.5 mm along a 15 m run; with only the truth's
         # 0.3 mm noise allowed, its no-effect set sat at 2.2 x the background
         if qm <= 0 and qt <= 0 and ql <= 0:
-            return np.zeros((n_out, 3))
+            return np.zeros((item.tt[item.i].size, 3))
         # keyed by what it reads: the walk, and the floor bumps placed on the run (the nominal
         # track below is dead-reckoned over them); the item is kept with it, so that another
         # item that comes to have the same id() is not served this one's
@@ -114,7 +111,7 @@ class Background:
             qm,
             qt,
             ql,
-            tuple((b["truck"], b["wheel"], b["s0"], b["h"]) for b in pr.bumps),
+            tuple((b["truck"], b["wheel"], b["s0"], b["h"]) for b in item.pr.bumps),
         )
         hit = self._tv.get(key)
         if hit is not None and hit[0] is item:

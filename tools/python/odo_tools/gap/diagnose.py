@@ -39,6 +39,7 @@ from .fit import (
     DBIC_PAIR,
     DBIC_SIGNIFICANT,
     SCREEN_TOL,
+    SOLVE_TOL,
     Z_GAP,
     Fit,
     Problem,
@@ -1309,11 +1310,6 @@ SLIP_EARLY = 3  # a slip single this high among the singles is asked about laten
 # at its true 33 ms, slip at 1.4 x)
 SLIP_CLOCK_S = (0.0, 0.01, 0.02, 0.03, 0.045, 0.06)
 SLIP_CLOCK_REFINE_S = 0.005
-# the clocks are screened by fits from one start, stopped at fit.SCREEN_TOL: two starts at the
-# solver's 1e-6 took 20 evaluations a clock, and the screen was 17 of a 10-run bumps diagnosis'
-# 44 s on one core (independent world, dev seed 2971 case 52; the second start ended no better
-# at any of its eight clocks). Only the clock chosen is fitted to the end, from every start, and
-# compared
 
 
 def _slip_not_latency(
@@ -1372,11 +1368,16 @@ def _slip_not_latency(
             _sig_head(prob, prob.items[0].channels()),
             floor_bumps=held,
             warm=({**{k: hypotheses.bounds(k)[2] for k in hyp.params}, **warm} if screen else warm),
-            tol=SCREEN_TOL if screen else 1e-6,
+            tol=SCREEN_TOL if screen else SOLVE_TOL,
         )
         # a clock other than none is one parameter
         return f.bic + (math.log(max(f.n, 2)) if L else 0.0)
 
+    # the clocks are screened by fits from one start, stopped at SCREEN_TOL: two starts solved
+    # to the end took 20 evaluations a clock, and the screen was 17 of a 10-run bumps
+    # diagnosis' 44 s on one core (independent world, dev seed 2971 case 52; the second start
+    # ended no better at any of its eight clocks). Only the clock chosen is fitted to the end,
+    # from every start, and compared
     def scan(clocks: tuple[float, ...]) -> dict[float, float]:
         got = par.each([functools.partial(cost, L, held, True) for L in clocks])
         return dict(zip(clocks, got, strict=True))

@@ -268,6 +268,7 @@ class Fit:
 # scan): the solver's 1e-6 took 30-45 evaluations from each of a grip limit's four starts, which
 # mostly end in the same minimum (a 10-run clapper, independent world, dev seed 2971 case 52)
 SCREEN_TOL = 1e-3
+SOLVE_TOL = 1e-6  # relative tolerance a fit is solved to (cost, step and gradient)
 
 
 def fit_params(
@@ -277,7 +278,7 @@ def fit_params(
     warm: dict | None = None,
     bnd: dict | None = None,
     starts: list[dict] | None = None,
-    tol: float = 1e-6,
+    tol: float = SOLVE_TOL,
 ) -> tuple[dict, dict]:
     """Bounded least squares of `keys` (others from `base`). `warm`: start values (pairs start
     from their singles' fits, one start; else the catalog start and, for slip/skid, a second).
@@ -355,7 +356,7 @@ def fit_hypothesis(
     floor_bumps: list | None = None,
     warm: dict | None = None,
     base_params: dict | None = None,
-    tol: float = 1e-6,
+    tol: float = SOLVE_TOL,
 ) -> Fit:
     """Fit one hypothesis on the problem's runs (`prs` are the same runs, for bump placement).
     A hypothesis with bumps places floor bumps found by the step detector (`floor_bumps` when the
