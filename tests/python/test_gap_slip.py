@@ -151,6 +151,25 @@ def test_slip_read_as_latency_is_told_apart_before_the_pairs(tmp_path: Path) -> 
     assert max(abs(v) for v in rep["instrument"]["latency_s"].values()) == 0.0
 
 
+def test_a_clock_screened_with_bumps_held_is_checked_against_none(tmp_path: Path) -> None:
+    """Simulator world, seed 2962 case 55: a clapper with floor bumps and catalog slip, and a
+    truth without latency whose starts read as 217-296 ms on four runs. The clocks were screened
+    with the bumps placed under those latencies held, and 20 ms screened best, though fitted to
+    the end it was far worse than none; the next ranking's slip single asked again, chose none,
+    and a third ranking followed. None is now fitted to the end beside the screen's best: the
+    latency and slip are told apart once, and the clock is none."""
+    from gap_support import sim_case
+    from odo_tools.gap.diagnose import diagnose
+
+    real = tmp_path / "real"
+    sim_case(2962, 55, real, "clapper", ["bumps", "slip"])
+    said: list[str] = []
+    rep = diagnose(real, real / "robot.json", mode="truth", progress=said.append).to_dict()
+    assert rep["verdict"]["effect"] == "bumps+slip", rep["verdict"]
+    assert said.count("latency and slip told apart: ranking again") == 1, said
+    assert max(abs(v) for v in rep["instrument"]["latency_s"].values()) == 0.0
+
+
 def test_traction_slip_the_phases_do_not_propose_is_still_tried(tmp_path: Path) -> None:
     """Independent world, seed 2791 case 51: a LabMate whose floor speed changes at most
     0.84 m/s^2. It loses so much on every start that the track is off everywhere after the first,
