@@ -501,7 +501,8 @@ def test_one_run_off_the_clock_does_not_take_the_session_clock_away() -> None:
 
 def test_a_session_whose_runs_disagree_keeps_only_long_latencies() -> None:
     """Four of ten runs off the median (slip read as latency varies with each path's
-    accelerations): no one clock; the shifts shorter than 1.5 ticks go, a long one stays."""
+    accelerations): no one clock; the shifts shorter than 1.5 ticks go, a long one stays. They
+    go to the clock the scan under slip chose, where it chose one (`unfixed`), else to none."""
     from odo_tools.gap.instrument import one_clock, session_latencies
 
     lat = [0.012, 0.012, 0.013, 0.011, 0.012, 0.012, 0.025, 0.026, 0.024, 0.070]
@@ -509,6 +510,9 @@ def test_a_session_whose_runs_disagree_keeps_only_long_latencies() -> None:
     assert one_clock(prs, found) == {"s": False}
     out = session_latencies(prs, found)
     assert [out[f"r{k}"] for k in range(9)] == [0.0] * 9
+    assert out["r9"] == 0.070
+    out = session_latencies(prs, found, 0.03)
+    assert [out[f"r{k}"] for k in range(9)] == [0.03] * 9
     assert out["r9"] == 0.070
 
 

@@ -131,6 +131,25 @@ def test_a_clock_no_run_fixed_is_found_under_slip_and_kept(tmp_path: Path) -> No
     assert all(abs(v - true) < 0.005 for v in rep["instrument"]["latency_s"].values())
 
 
+def test_a_short_read_in_a_session_that_disagrees_keeps_the_scanned_clock(tmp_path: Path) -> None:
+    """Independent world, dev seed 2821 case 9: a set with no effect whose truth runs 31 ms late
+    on 20 ms ticks, its robot's encoders coarse (7 mm a count). The scan under slip chose one
+    clock, 30 ms; the judge read each run again under the best candidate (scrub), three runs
+    read 39-40 ms and six less than 1.5 ticks, so the session had no one clock and the short
+    reads were taken as none. The held-out runs then sat 6.98 x the background in their
+    accelerations: "unexplained". A short read now takes the clock the scan chose (none where
+    no scan chose one): no significant gap."""
+    from odo_tools.gap.diagnose import diagnose
+
+    real = tmp_path / "real"
+    c = indep_case(2821, 9, real, "set", {})
+    rep = diagnose(real, real / "robot.json", mode="truth").to_dict()
+    assert rep["verdict"]["effect"] == "no significant gap", rep["verdict"]
+    true = c["fidelity"]["truth_latency_s"]
+    lat = rep["instrument"]["latency_s"].values()
+    assert all(abs(v - true) < 0.01 for v in lat), rep["instrument"]
+
+
 def test_slip_read_as_latency_is_told_apart_before_the_pairs(tmp_path: Path) -> None:
     """Simulator world, seed 2712 case 28: a clapper with catalog slip (k 0.98 per m/s^2) and a
     truth without latency, whose starts read as 97 ms on four runs. With slip among the top

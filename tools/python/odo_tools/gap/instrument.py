@@ -349,7 +349,8 @@ def session_latencies(
     agrees with that clock and gives the clock to the few that do not (tried: the clock for
     every run, which moved as many verdicts of the independent world one way as the other). A
     session whose runs disagree keeps each run's own shift, but only where it is too long for
-    an effect to fake. `unfixed`: the latency where no run of a session fixes one."""
+    an effect to fake; a shorter one takes `unfixed`. `unfixed`: the latency where no run of a
+    session fixes one (the clock the scan under slip chose, or none)."""
     out = {}
     for pr in prs:
         name = pr.run.name
@@ -371,7 +372,7 @@ def session_latencies(
                 if abs(L - clock) > _tolerance(clock, tick):
                     out[pr.run.name] = clock
             elif abs(L) < CLOCK_TICKS * float(np.median(pr.dt)):
-                out[pr.run.name] = 0.0
+                out[pr.run.name] = unfixed
     return out
 
 
