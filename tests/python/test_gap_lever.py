@@ -102,3 +102,28 @@ def test_no_skid_is_looked_for_where_the_geometry_leaves_no_gap(tmp_path, seed, 
     assert notes and not any("cornering skid" in n for n in notes), ds.notes
     want = c["fidelity"]["truth_lever_arm_mm"][truck]
     assert ds.instrument.lever_mm[0] == pytest.approx(want, abs=1.0)
+
+
+@pytest.mark.parametrize(
+    "seed,k,laws",
+    [
+        (2601, 5, {"eb": "fixed"}),  # an Eb of 0.979 on truck A
+        (2608, 38, {}),  # no effect; markers 12 mm behind (A) and ahead (B) of the axles
+    ],
+)
+def test_each_trucks_eb_is_its_own_once_the_markers_are_near(tmp_path, seed, k, laws) -> None:
+    """A clapper's markers read on arcs under a preliminary geometry: with one Eb for both
+    trucks, an Eb on truck A put both markers 1.7-1.9 mm sideways and a joint-encoder offset
+    joined the Eb (dev seed 2601 case 5); with each truck its own Eb from the first round, truck
+    B took an Eb of 0.86 for its marker's forward offset while both markers were still taken on
+    the axles (dev 2608 case 38, no effect, then "unexplained" at 10.6 x). Each truck has its
+    own Eb from the second round on."""
+    from odo_tools.gap import diagnose as D
+
+    real = tmp_path / "real"
+    c = indep_case(seed, k, real, "clapper", laws)
+    ds = D.load(real, real / "robot.json")
+    assert any("lever arm from" in n for n in ds.notes), ds.notes
+    lever = c["fidelity"]["truth_lever_arm_mm"]
+    for t, name in enumerate("AB"):
+        assert ds.instrument.lever_mm[t] == pytest.approx(lever[name], abs=1.0), name

@@ -202,9 +202,10 @@ def _lever_on_arcs(ds: Dataset) -> None:
     own Es in that fit: one for both put an Es on one truck partly on the other, whose lever arm
     then came out 3-4 mm sideways, and the link's direction between the two tracked points
     0.3 deg off, which a joint-encoder offset took up beside the Es (independent world, seed
-    2781 cases 13 and 31, traced after that seed was measured). Only the Es: with each truck's
-    whole geometry, a slip on one truck moved the other's marker 2 mm forward and a link bias
-    joined the slip (dev seed 2761 cases 10 and 41).
+    2781 cases 13 and 31, traced after that seed was measured), and its own Eb from the second
+    round (`_lever_rounds`). Not the whole geometry: with each truck's own, a slip on one truck
+    moved the other's marker 2 mm forward and a link bias joined the slip (dev seed 2761 cases
+    10 and 41).
     On an arc a marker ahead of the axle moves sideways just as a tyre skids outwards: the
     lever arms are found without a skid in the preliminary fit and with a cornering skid on
     each set of trucks, and those whose tracks (and linkage) fit best by quasi-BIC are kept.
@@ -286,9 +287,17 @@ def _lever_rounds(ds: Dataset, keys: list[str]) -> _Levers:
     inst = ds.instrument.copy()
     items = ds.items
     notes: list[str] = []
-    for _ in range(2):
+    # each truck its own Eb once the markers are near: under markers taken on the axles a
+    # truck's Eb takes its marker's forward offset instead (dev 2608 case 38, a clapper with no
+    # effect: truck B an Eb of 0.86 for its marker 12 mm ahead, the held-out runs at 10.6 x);
+    # one Eb for both left an Eb on truck A 1.7-1.9 mm in both markers sideways, the link's
+    # direction turned, and a rotary bias joined the Eb (dev 2601 case 5)
+    own_eb = keys
+    if ds.robot.n_trucks > 1 and "eb.value" in keys:
+        own_eb = [k for k in keys if k != "eb.value"] + ["eb.value.A", "eb.value.B"]
+    for rnd in range(2):
         prob = Problem("truth", items)
-        P, _ = fit_params(prob, keys)
+        P, _ = fit_params(prob, own_eb if rnd else keys)
         notes = []
         for t in range(ds.robot.n_trucks):
             if not any(n.startswith(f"truck {'AB'[t]}:") for n in ds.notes):
