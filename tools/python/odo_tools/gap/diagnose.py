@@ -214,12 +214,19 @@ def _lever_on_arcs(ds: Dataset) -> None:
     measured); with it always, a marker 25 mm behind the axle read as a skid (dev 2761 case
     44). The skid is looked for only where the fit without one leaves the tracks a gap."""
     keys = [k for k in PRELIM if k.split(".")[0] in catalog.hypotheses("truth", ds.robot.vehicle)]
-    if ds.robot.n_trucks > 1 and "es.value" in keys:
-        keys = [k for k in keys if k != "es.value"] + ["es.value.A", "es.value.B"]
+    if ds.robot.n_trucks > 1:
+        keys = _per_truck(keys, "es.value")
     best = _lever_rounds(ds, keys)
     if "skid" in catalog.hypotheses("truth", ds.robot.vehicle):
         best = _lever_with_skid(ds, keys, best)
     ds.instrument, ds.notes, ds.items = best.inst, best.notes, best.items
+
+
+def _per_truck(keys: list[str], key: str) -> list[str]:
+    """keys with `key` (one value for both trucks) replaced by truck A's and truck B's own."""
+    if key not in keys:
+        return keys
+    return [k for k in keys if k != key] + [f"{key}.A", f"{key}.B"]
 
 
 class _Levers(NamedTuple):
@@ -292,9 +299,7 @@ def _lever_rounds(ds: Dataset, keys: list[str]) -> _Levers:
     # effect: truck B an Eb of 0.86 for its marker 12 mm ahead, the held-out runs at 10.6 x);
     # one Eb for both left an Eb on truck A 1.7-1.9 mm in both markers sideways, the link's
     # direction turned, and a rotary bias joined the Eb (dev 2601 case 5)
-    own_eb = keys
-    if ds.robot.n_trucks > 1 and "eb.value" in keys:
-        own_eb = [k for k in keys if k != "eb.value"] + ["eb.value.A", "eb.value.B"]
+    own_eb = _per_truck(keys, "eb.value") if ds.robot.n_trucks > 1 else keys
     for rnd in range(2):
         prob = Problem("truth", items)
         P, _ = fit_params(prob, own_eb if rnd else keys)
