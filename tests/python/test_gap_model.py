@@ -248,3 +248,59 @@ def test_count_loss_at_a_rate_ceiling_recovers_the_hidden_speed() -> None:
     off = count_loss_plateau(pr, pr.ds[:, 0, :].copy(), 0, P)[:, 0]
     assert abs(off.sum() - true.sum()) > 0.1 * (true.sum() - counted.sum())
 
+
+
+def test_a_rate_ceiling_is_found_under_jittered_stamps() -> None:
+    """model.counted_speed: a decoder at its ceiling counts the same per tick; a log stamped on
+    arrival jitters the recorded tick lengths (here +-0.7 % on 10 ms) without the counts
+    following them. The ceiling and every saturated tick are found on the nominal tick, and the
+    hidden travel comes back; where the counts do follow the recorded lengths (a clock that
+    samples late), the recorded lengths are kept."""
+    from odo_tools.gap.model import (
+        Prepared,
+        count_loss_plateau,
+        counted_speed,
+        plateau_level,
+    )
+
+    dt, a, vmax, ceil, mm = 0.01, 1000.0, 980.0, 750.0, 0.0025
+    fine = np.arange(0.0, 4.0, 1e-4)
+    ramp = np.minimum(np.minimum(a * fine, a * (fine[-1] - fine)), vmax)
+    v = np.concatenate([np.zeros(1000), ramp, np.zeros(1000)])  # 1e-4 s samples
+    per = round(dt / 1e-4)
+    cum = np.concatenate([[0.0], np.cumsum(np.minimum(v, ceil) * 1e-4)])[::per]
+    counted = np.diff(np.floor(cum / mm)) * mm  # whole counts per tick
+    true = v.reshape(-1, per).sum(axis=1) * 1e-4
+    n = counted.size + 1
+    rng = np.random.default_rng(5)
+
+    def prep(d: np.ndarray, stamps: np.ndarray) -> Prepared:
+        ds = d[:, None, None] * np.ones((1, 1, 2))
+        S = np.concatenate([np.zeros((1, 1, 2)), np.cumsum(np.abs(ds), axis=0)])
+        return Prepared(
+            None, stamps, ds, S, [400.0], [75.0], np.diff(stamps), count_mm=[mm]
+        )
+
+    stamps = np.arange(n) * dt + rng.uniform(-0.35e-4, 0.35e-4, n)  # read on arrival
+    pr = prep(counted, stamps)
+    rec = np.abs(pr.ds[:, 0, :]) / pr.dt[:, None]
+    top = rec[rec > 0.98 * ceil]
+    assert np.ptp(top) / ceil > 3 * 0.003  # the stamps spread the flat top beyond PLATEAU_TOL
+    assert plateau_level([pr]) == pytest.approx(ceil, rel=5e-4)
+    sat = np.abs(pr.ds[:, 0, 0]) >= ceil * dt * (1 - 1e-3)
+    assert np.all(counted_speed(pr, 0)[sat, 0] >= plateau_level([pr]) * (1 - 0.003))
+    P = {
+        "count_loss@plateau.level_mm_s": plateau_level([pr]),
+        "count_loss@plateau.excess_mm_s": vmax - ceil,
+        "count_loss@plateau.a_m_s2": a / 1000.0,
+    }
+    got = count_loss_plateau(pr, pr.ds[:, 0, :].copy(), 0, P)[:, 0]
+    assert true.sum() - counted.sum() > 500.0  # the counts lost half a metre
+    assert abs(got.sum() - true.sum()) < 0.02 * (true.sum() - counted.sum())
+    # a clock whose ticks themselves vary: the counts follow the recorded lengths
+    ticks = np.concatenate([[0.0], np.cumsum(dt * rng.uniform(0.99, 1.01, n - 1))])
+    cum2 = np.interp(ticks, np.arange(cum.size) * dt, cum)
+    pr2 = prep(np.diff(np.floor(cum2 / mm)) * mm, ticks)
+    assert counted_speed(pr2, 0) is not None
+    assert np.array_equal(counted_speed(pr2, 0), np.abs(pr2.ds[:, 0, :]) / pr2.dt[:, None])
+    assert plateau_level([pr2]) == pytest.approx(ceil, rel=5e-4)

@@ -204,7 +204,7 @@ def test_rate_ceiling_law_over_every_stretch_at_once_is_the_per_stretch_loop_bit
     """model.count_loss_plateau adds the hidden travel of every saturated tick of both wheels
     in one step (`_plateau_stretches` keeps them as flat arrays); the form it replaced looped
     over the stretches, one numpy expression each."""
-    from odo_tools.gap.model import PLATEAU_SUB, PLATEAU_TOL, count_loss_plateau
+    from odo_tools.gap.model import PLATEAU_SUB, PLATEAU_TOL, count_loss_plateau, counted_speed
 
     rng = np.random.default_rng(11)
     ds = _wheels(rng, 1200)
@@ -219,7 +219,7 @@ def test_rate_ceiling_law_over_every_stretch_at_once_is_the_per_stretch_loop_bit
             "count_loss@plateau.a_m_s2": a,
         }
         want = ds.copy()
-        sat = np.abs(ds) / pr.dt[:, None] >= level * (1.0 - PLATEAU_TOL)
+        sat = counted_speed(pr, 0) >= level * (1.0 - PLATEAU_TOL)  # the wheel speed it reads
         f = (np.arange(PLATEAU_SUB) + 0.5) / PLATEAU_SUB
         stretches = 0
         for w in (0, 1):  # the form it replaced: one stretch at a time
