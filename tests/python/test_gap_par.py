@@ -134,3 +134,54 @@ def test_lever_arms_under_skid_subsets_are_the_same_on_two_cores(tmp_path) -> No
         want = TruthMode(pr, b.robot, b.instrument).residuals({})  # under the arms found
         assert np.array_equal(x.residuals({}), want)
         assert np.array_equal(y.residuals({}), want)
+
+
+# batches of which a task fails, one after another in one process: the path
+# test_a_bad_input_raised_in_a_worker_reaches_the_caller takes once
+_ERRORS_AGAIN = r"""
+import sys, time
+from odo_tools.gap import par
+from odo_tools.gap.errors import GapInputError
+
+def bad():
+    raise GapInputError("run.csv", "bad", 1)
+
+def later(i):
+    def f():
+        if i == 0:
+            raise GapInputError("run.csv", "bad", 1)
+        time.sleep(0.01)  # the others still running, or not yet handed out
+        return i
+    return f
+
+for k in range(int(sys.argv[1])):
+    with par.cores(2):
+        try:
+            par.each([bad, bad] if k % 2 else [later(i) for i in range(6)])
+        except GapInputError:
+            continue
+    raise SystemExit(f"batch {k}: no error came back")
+"""
+
+
+@pytest.mark.skipif(not TWO, reason="one core: nothing runs beside the parent")
+def test_a_failing_batch_never_leaves_the_pool_waiting() -> None:
+    """par.each lets a failing batch's other tasks end before the pool closes. Leaving the pool
+    at once terminated it while its task handler still fed the workers, and one batch in some
+    hundreds waited for ever (CPython issues 96995, 78178): ctest's py.test_gap_par hung 10 min
+    on the test above. 400 such batches must end, in a process the test can stop."""
+    import subprocess
+    import sys
+
+    # a busy process beside it: the race wants the workers and the pool's threads interleaved
+    # as a loaded machine interleaves them (unloaded, few runs of the old form hung)
+    busy = subprocess.Popen([sys.executable, "-c", "while True: pass"])
+    try:
+        cmd = [sys.executable, "-c", _ERRORS_AGAIN, "400"]
+        r = subprocess.run(cmd, capture_output=True, text=True, timeout=180)
+    except subprocess.TimeoutExpired:
+        pytest.fail("a batch with a failing task left the pool waiting (killed after 180 s)")
+    finally:
+        busy.kill()
+        busy.wait()
+    assert r.returncode == 0, r.stderr[-2000:]

@@ -74,10 +74,19 @@ def each(
     try:
         with multiprocessing.get_context("fork").Pool(n) as pool:
             out = []
-            for i, r in enumerate(pool.imap(_call, range(len(tasks)), chunksize=1)):
-                if progress and labels:
-                    progress(labels[i])
-                out.append(r)
+            try:
+                for i, r in enumerate(pool.imap(_call, range(len(tasks)), chunksize=1)):
+                    if progress and labels:
+                        progress(labels[i])
+                    out.append(r)
+            except Exception:
+                # a task's error: the other tasks end before the pool does. Leaving the `with`
+                # at once terminates the pool while its task handler still feeds the workers,
+                # which can wait for ever (CPython issues 96995 and 78178; ctest's
+                # py.test_gap_par once waited 10 min here, two workers reaped by nobody)
+                pool.close()
+                pool.join()
+                raise
             return out
     finally:
         _tasks = ()
