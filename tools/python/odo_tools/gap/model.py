@@ -481,9 +481,9 @@ def counted_speed(pr: Prepared, truck: int) -> np.ndarray:
     log stamped on arrival, not at the sample. There a decoder at its count-rate ceiling counts
     the same per tick while the stamps, 0.7 % apart on 10 ms ticks, spread its speed over three
     times PLATEAU_TOL, the ceiling took the fastest few, and a third of the saturated ticks were
-    found (independent world, seed 2861 case 19: a clapper's sprints read as no count loss,
-    traced after that seed was measured). Which of the two: the one that leaves a moving
-    wheel's speed the steadier from tick to tick (cached per run)."""
+    found (independent world, seed 2861 case 19, a clapper on 10 ms ticks; traced after that
+    seed was measured). Which of the two: the one that leaves a moving wheel's speed the
+    steadier from tick to tick (cached per run)."""
     key = ("counted", truck)
     hit = pr.slip_cache.get(key)
     if hit is not None:
