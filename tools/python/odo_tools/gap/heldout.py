@@ -169,8 +169,9 @@ def run_gap(item, P: dict, sigma: np.ndarray, bg: Background) -> tuple[RunGap, f
         mm = item.gap(P)
         deg = float(np.degrees(np.sqrt(np.mean(r[:, 0] ** 2))))
         L = item.robot.linkage.get("length_mm", 1000.0)
-        bmm = float(np.sqrt(np.sum((sigma * np.array([L, L, 1.0])[: sigma.size]) ** 2)))
-        bdeg = float(np.degrees(sigma[0]))
+        v = sigma**2 + item.own_var(sigma).mean(axis=0)  # the wheel counters' quantisation too
+        bmm = float(np.sqrt(np.sum(v * np.array([L, L, 1.0])[: sigma.size] ** 2)))
+        bdeg = float(np.degrees(np.sqrt(v[0])))
     end = (mm, deg) if item.name == "returns" else (0.0, 0.0)
     return RunGap(name, mm, deg, float(np.sum(z * z)), int(z.size), *end), bmm, bdeg
 
