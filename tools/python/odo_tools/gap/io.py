@@ -282,7 +282,8 @@ def read_log(path: str | Path, robot: Robot) -> SensorLog:
                     f"count {int(v.max())} exceeds the robot's {bits}-bit counter",
                     int(np.nonzero(sel)[0][np.argmax(v >= (1 << bits))]) + 1,
                 )
-            counts[:, tr, w] = _fill(v, idx, n)
+            wrap = 1 << min(bits, lay[fid][name].length)
+            counts[:, tr, w] = np.round(_fill(v, idx, t, wrap)).astype(np.int64) % wrap
         status = decode_signal(pay[sel], lay[fid]["Status"]).astype(np.int64)
         on = idx >= 0
         for w, bit in enumerate((STATUS_LEFT_SKIPPED, STATUS_RIGHT_SKIPPED)):
@@ -291,11 +292,11 @@ def read_log(path: str | Path, robot: Robot) -> SensorLog:
     sel_r, sel_l = ids == ID_ROTARY, ids == ID_LINEAR
     if sel_r.any():
         idx = _align(path, ts[sel_r], t, np.nonzero(sel_r)[0])
-        log.alpha_deg = _fill(decode_signal(pay[sel_r], lay[ID_ROTARY]["Alpha"]), idx, n)
-        log.beta_deg = _fill(decode_signal(pay[sel_r], lay[ID_ROTARY]["Beta"]), idx, n)
+        log.alpha_deg = _fill(decode_signal(pay[sel_r], lay[ID_ROTARY]["Alpha"]), idx, t, 360.0)
+        log.beta_deg = _fill(decode_signal(pay[sel_r], lay[ID_ROTARY]["Beta"]), idx, t, 360.0)
     if sel_l.any():
         idx = _align(path, ts[sel_l], t, np.nonzero(sel_l)[0])
-        log.l_mm = _fill(decode_signal(pay[sel_l], lay[ID_LINEAR]["Length"]), idx, n)
+        log.l_mm = _fill(decode_signal(pay[sel_l], lay[ID_LINEAR]["Length"]), idx, t)
     return log
 
 
@@ -325,19 +326,37 @@ def _align(path: Path, t_frames: np.ndarray, t_ticks: np.ndarray, lines: np.ndar
     return np.where(off, -1, idx)
 
 
-def _fill(v: np.ndarray, idx: np.ndarray, n: int) -> np.ndarray:
-    """Values per tick; a tick without a frame holds the previous value (the decoder's register).
-    Frames of no tick (idx -1, _align) are skipped."""
+def _fill(v: np.ndarray, idx: np.ndarray, t: np.ndarray, period: float | None = None) -> np.ndarray:
+    """Values per tick (times t). A tick whose frame the bus lost takes the value interpolated
+    in time between its neighbours' frames, the shorter way round a counter's or an angle's
+    `period` (a counter rounded to whole counts); before the first frame and after the last
+    it holds the nearest. Holding the previous value instead put a whole tick of one truck's
+    travel into the window that ended there and took it back from the next: a clapper with no
+    effect on a bus losing 0.08 % of its frames read +/-7.5 mm in l, 500 times its noise, and
+    linkage mode called it "unexplained" (independent world). Frames of no tick (idx -1,
+    _align) are skipped."""
     keep = idx >= 0
-    v, idx = np.asarray(v)[keep], idx[keep]
-    out = np.full(n, np.nan)
+    v, idx = np.asarray(v, dtype=float)[keep], idx[keep]
+    n = t.size
+    have = np.zeros(n, dtype=bool)
+    have[idx] = True
+    out = np.zeros(n)
     out[idx] = v
-    if np.isnan(out[0]):
-        out[0] = v[0]
-    mask = np.isnan(out)
-    if mask.any():
-        last = np.maximum.accumulate(np.where(~mask, np.arange(n), 0))
-        out = out[last]
+    lost = np.nonzero(~have)[0]
+    got = np.nonzero(have)[0]
+    if lost.size and got.size == 1:
+        out[lost] = out[got[0]]
+    elif lost.size:
+        k = np.clip(np.searchsorted(got, lost), 1, got.size - 1)
+        a, b = got[k - 1], got[k]
+        f = np.clip((t[lost] - t[a]) / (t[b] - t[a]), 0.0, 1.0)
+        d = out[b] - out[a]
+        if period is not None:
+            d = np.mod(d + 0.5 * period, period) - 0.5 * period
+        x = out[a] + f * d
+        if period is not None:
+            x = np.mod(x, period)
+        out[lost] = x
     return out
 
 
