@@ -27,7 +27,15 @@ def _straight_windows(it) -> np.ndarray:
     return inline & equal & moving
 
 
-def test_a_clapper_with_coarse_counts_and_no_effect_is_no_gap(tmp_path: Path) -> None:
+@pytest.fixture(scope="module")
+def real(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """Dev seed 2606 case 11 of the independent world (below)."""
+    out = tmp_path_factory.mktemp("lk") / "real"
+    indep_case(2606, 11, out, "clapper", {})
+    return out
+
+
+def test_a_clapper_with_coarse_counts_and_no_effect_is_no_gap(real: Path) -> None:
     """Dev seed 2606 case 11 of the independent world: a clapper on 0.154 mm counts and a 0.02 mm
     linear encoder, no effect. Driving straight in line, the predicted l is truck A's travel less
     truck B's, each the mean of two wheels read at both ends of the window: (4 x 2 readings of
@@ -36,8 +44,6 @@ def test_a_clapper_with_coarse_counts_and_no_effect_is_no_gap(tmp_path: Path) ->
     "unexplained" at 2.8 x."""
     from odo_tools.gap.diagnose import diagnose, load
 
-    real = tmp_path / "real"
-    indep_case(2606, 11, real, "clapper", {})
     ds = load(real, real / "robot.json", "linkage")
     step = ds.prs[0].count_mm[0]
     assert ds.robot.linkage["linear_resolution_mm"] < 0.2 * step  # the case is what it says
@@ -48,3 +54,17 @@ def test_a_clapper_with_coarse_counts_and_no_effect_is_no_gap(tmp_path: Path) ->
     assert float(np.median(sd)) == pytest.approx(step / math.sqrt(6.0), rel=0.25)
     rep = diagnose(real, real / "robot.json", 0.5, 1, "linkage").to_dict()
     assert rep["verdict"]["effect"] == "no significant gap", rep["verdict"]
+
+
+def test_the_linkage_gap_is_in_mm_and_grows_with_a_geometry_error(real: Path) -> None:
+    """The linkage gap a person reads (LinkageMode.gap: the prediction error of every window, the
+    angles at the link's length, in mm): the encoders' cells alone leave a few mm, and a 2 %
+    wheelbase error, which turns each truck's predicted heading on every arc, doubles it and
+    more on every run."""
+    from odo_tools.gap.diagnose import load
+
+    ds = load(real, real / "robot.json", "linkage")
+    for it in ds.items:
+        g0, g1 = it.gap({}), it.gap({"eb.value": 1.02})
+        assert 0.5 < g0 < 20.0, (it.pr.run.name, g0)
+        assert g1 > 2.0 * g0, (it.pr.run.name, g0, g1)

@@ -743,8 +743,10 @@ class LinkageMode:
         return self.residuals(P) / np.sqrt(sigma**2 + self.own_var(sigma))
 
     def gap(self, P: dict) -> float:
-        r = self.residuals(P)[0]
-        return float(math.hypot(r[0], r[1]))
+        r = self._pred(P)
+        L = self.robot.linkage.get("length_mm", self.robot.trailer.get("trailer_length_mm", 1000.0))
+        mm = np.column_stack([r[:, 0] * L, r[:, 1] * (L if self.clapper else 1.0), r[:, 2]])
+        return float(np.sqrt(np.mean(np.sum(mm**2, axis=1))))
 
 
 MODES = {"truth": TruthMode, "returns": ReturnsMode, "linkage": LinkageMode}
