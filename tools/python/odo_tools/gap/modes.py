@@ -704,7 +704,8 @@ class LinkageMode:
                 wheels.append((step, rests, jf, jl))
         half = 0.5 * np.array(self.steps[: self.J.shape[2]])
         end = np.zeros(nc)
-        end[: 3 if self.clapper else 1] = self.steps[: 3 if self.clapper else 1]
+        k = self.n_readings
+        end[:k] = self.steps[:k]
         acc = np.zeros((nw, nc))
         for _ in range(draws):
             u = rng.uniform(-1.0, 1.0, (nw, half.size)) * half
@@ -730,11 +731,15 @@ class LinkageMode:
             finally:
                 self.pr = pr
         d = cols[0] - cols[1]
-        if not self.clapper:
-            d[:, 0] = wrap_rad(d[:, 0])
-        else:
-            d[:, :2] = wrap_rad(d[:, :2])
+        k = self.n_readings - 1 if self.clapper else 1  # the angle channels
+        d[:, :k] = wrap_rad(d[:, :k])
         return d / (2.0 * h)
+
+    @property
+    def n_readings(self) -> int:
+        """Channels that are encoder readings (the first ones): a clapper's alpha, beta and l, a
+        set's alpha (its other two are the hitch's predicted offsets)."""
+        return 3 if self.clapper else 1
 
     def noise_weights(self) -> np.ndarray:
         return np.ones(len(self.channels()))
