@@ -176,10 +176,12 @@ def test_a_member_that_bends_the_fitting_tracks_away_is_refused(tmp_path: Path) 
     ds, sel, rk = _ranked(real)
     single = next(f for f in rk.cands if f.name == "es[B]")
     pair = next(f for f in rk.cands if f.name == "eb+es[B]")
-    assert pair.bic < single.bic  # the windows prefer the pair ...
+    # the windows preferred the pair while the trailer's marker was read under the first
+    # preliminary fit; read under the nominal geometry (_lever_on_arcs) they prefer the single
+    # by 1.9 BIC, and the member rule is asked directly
     r1 = D._track_ratio(single, rk.prob, ds, sel)
     r2 = D._track_ratio(pair, rk.prob, ds, sel)
-    assert r2 > 5 * r1, (r1, r2)  # ... which bends the tracks it was fitted to
+    assert r2 > 5 * r1, (r1, r2)  # the pair bends the tracks it was fitted to
     assert not D._more(single, pair, rk.prob, ds, sel)
     v = D.diagnose(real, real / "robot.json").to_dict()["verdict"]
     assert v["effect"] == "es" and v["best_hypothesis"] == "es[B]", v
