@@ -318,3 +318,37 @@ def test_an_es_the_tracks_choose_is_the_floor_when_the_walk_accounts_for_it(
     rep = D.diagnose(real, real / "robot.json", mode="truth").to_dict()
     assert rep["verdict"]["effect"] == "roughness", rep["verdict"]
     assert "es fitted to the tracks" in rep["proposals"]["the accumulated track"]
+
+
+def test_a_linkage_bias_beside_the_tracks_geometry_must_earn_its_place(tmp_path: Path) -> None:
+    """Independent world, seed 3071 case 49 (traced after that seed was measured): a set whose
+    truck A has a tyre that grows with speed. The windows' best was a rotary bias of 0.05 deg;
+    the tracks (12 x the background nominally) name Ed's growth law on truck A, and the bias
+    stays beside it only where it still earns its place on the windows (diagnose._more): here it
+    does not, and the verdict is the Ed alone (it was "unexplained", then "ed+rotary_bias")."""
+    real = tmp_path / "real"
+    c = indep_case(3071, 49, real, "set", {"ed": "speed"})
+    rep = D.diagnose(real, real / "robot.json", mode="truth").to_dict()
+    v = rep["verdict"]
+    assert v["effect"] == "ed" and v["best_hypothesis"] == "ed@growth[A]", v
+    assert c["true"]["effects"]["ed"]["truck"] == "A"
+    assert v["evidence"]["heldout_ratio_after"] < 1.5, v["evidence"]
+    assert "fitted to the tracks" in rep["proposals"]["the accumulated track"]
+
+
+def test_geometry_the_tracks_want_joins_a_best_that_has_none(tmp_path: Path) -> None:
+    """Independent world, seed 3071 case 40 (traced after that seed was measured): a set with
+    count loss at a rate ceiling and an Ed of 1.00127 on truck A. The windows name the count
+    loss, which leaves the fitting runs' tracks at 4.4 x the background; truck A's Ed fitted to
+    the tracks beside it, the count loss as the windows fitted it, halves their excess misfit
+    there and on the paths it was not fitted to (diagnose._geometry_beside)."""
+    real = tmp_path / "real"
+    c = indep_case(3071, 40, real, "set", {"count_loss": "rate_limit", "ed": "fixed"})
+    rep = D.diagnose(real, real / "robot.json", mode="truth").to_dict()
+    v = rep["verdict"]
+    assert v["effect"] == "count_loss+ed", v
+    assert v["params"]["ed.value.A"] == pytest.approx(c["true"]["effects"]["ed"]["value"], abs=3e-4)
+    h = rep["heldout"]
+    assert h["ratio_after"] < 0.25 * h["ratio_before"], h  # count loss alone: 88.9 -> 38.6 x
+    said = rep["proposals"]["the accumulated track"]
+    assert "count_loss@plateau[A]+ed[A] fitted to the tracks" in said, said
