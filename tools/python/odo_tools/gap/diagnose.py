@@ -845,8 +845,8 @@ def _track_refit(ds: Dataset, sel: Selection, rk: Ranking, progress: Progress = 
         # two runs agree (heldout.apply): an Ed that soaked up their heading steps took a bump
         # case from the windows' best (dev seed 9 case 2)
         return False
-    # a linkage encoder's bias acts on its readings, which the tracks leave out: it is kept
-    # beside whatever geometry the tracks choose (an Ed that changed nothing took a set's
+    # a linkage encoder's bias acts on its readings, which the tracks leave out: it is fitted
+    # again beside whatever geometry the tracks choose (an Ed that changed nothing took a set's
     # rotary bias, 20244 BIC on the windows, from the windows' best: independent seed 2681
     # case 33), and the tracks are asked where a bias is the windows' best as anywhere else (a
     # link bias of 0.17 mm beat a clapper's Ed on one truck, which took the fitting tracks from
