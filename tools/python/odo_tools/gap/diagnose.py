@@ -983,8 +983,9 @@ def _geometry_beside(ds: Dataset, sel: Selection, rk: Ranking, progress: Progres
     best. Each geometry family (on both trucks, and on the truck whose tracks sit furthest
     off) joins the best, fitted to the accumulated track; the best of them is kept when it
     halves the tracks' excess misfit there and on the paths left out (`_member_joins`, the rule
-    a further member meets in `_track_refit`; True). A set's count loss and Ed on its truck A were "count loss", the tracks at 4.4 x the
-    background under it (independent world 3071 case 40, traced after that seed was measured)."""
+    a further member meets in `_track_refit`; True). A set's count loss and Ed on its truck A
+    were "count loss", the tracks at 4.4 x the background under it (independent world 3071
+    case 40, traced after that seed was measured)."""
     if ds.mode != "truth" or rk.best.hyp is None or rk.best.hyp.has_bumps:
         return False
     fams = [f for f in TRACK_FAMILIES if f in catalog.hypotheses("truth", ds.robot.vehicle)]
