@@ -9,7 +9,7 @@ from types import SimpleNamespace
 
 import numpy as np
 import pytest
-from gap_support import indep_named
+from gap_support import indep_case, indep_named
 from odo_tools.gap import bumps
 
 
@@ -244,6 +244,66 @@ def test_bumps_the_tracks_want_replace_a_best_that_leaves_them(tmp_path: Path) -
     said = rep["proposals"]["the accumulated track"]
     left = re.search(r"(?:the floor bumps leave|bumps at) ([0-9.]+) x", said)
     assert left and float(left.group(1)) < 3.5, said  # the tracks: 36 x nominally
+
+
+def test_bumps_join_a_best_that_leaves_the_tracks_beyond_three_backgrounds(tmp_path: Path) -> None:
+    """Independent world, dev seed 2604 case 5: a clapper over ramps of 17-18 mm, with a scrub
+    on truck B. The bumps single ranks far below the scrub, so no pair holds both, and "scrub"
+    alone was named with the fitting runs' tracks at 8 x the background and the held-out runs
+    at 9.7 x. The bumps detected under the scrub, fitted beside it, leave the tracks at 1.8 x
+    (diagnose._bumps_beside)."""
+    from odo_tools.gap.diagnose import diagnose
+
+    real = tmp_path / "real"
+    indep_case(2604, 5, real, "clapper", {"bumps": "ramps", "scrub": "torque"})
+    rep = diagnose(real, real / "robot.json", mode="truth").to_dict()
+    v = rep["verdict"]
+    assert v["effect"] == "bumps+scrub", v
+    assert "scrub.k.B" in v["params"], v["params"]
+    hd = rep["heldout"]
+    assert hd["ratio_after"] < 0.1 * hd["ratio_before"], hd  # scrub alone: 40.4 -> 9.7 x
+    said = rep["proposals"]["the floor bumps"]
+    left = re.search(r"the bumps detected under it, leaves ([0-9.]+) x", said)
+    assert left and float(left.group(1)) < 3.0, said
+
+
+@pytest.mark.parametrize(
+    ("best", "pair", "found", "taken"),
+    [
+        (8.0, 1.79, 3, True),  # independent 2604 case 5: ramps beside a scrub
+        (1.64, 0.71, 3, True),  # independent 2601 case 38: ramps beside an Eb
+        (62.1, 61.8, 1, False),  # independent 2861 case 3: the bumps halve nothing
+        (1.4, 0.5, 3, False),  # the best already leaves the tracks within the background
+        (8.0, 1.0, 0, False),  # nothing detected under the best
+    ],
+)
+def test_bumps_join_a_best_only_where_they_halve_the_tracks_excess(
+    monkeypatch: pytest.MonkeyPatch, best: float, pair: float, found: int, taken: bool
+) -> None:
+    """The rule of diagnose._bumps_beside on the track ratios (R, in backgrounds) of the best
+    and of the best with the bumps detected under it, with the ratios of dev cases."""
+    from odo_tools.gap import diagnose
+    from odo_tools.gap.hypotheses import Hypothesis, catalog_law
+
+    def fit(hyp: Hypothesis, floor: list) -> SimpleNamespace:
+        return SimpleNamespace(name=hyp.name, hyp=hyp, bumps=floor, params={}, model_params=dict)
+
+    monkeypatch.setattr(diagnose, "_track_ratio", lambda f, *_: pair if f.bumps else best)
+    spots = [_bump("cw:1", ["run-cw-01"], 1000.0 * i, 0.0) for i in range(found)]
+    monkeypatch.setattr(diagnose, "detect_bumps", lambda *_: spots)
+    monkeypatch.setattr(diagnose, "cluster_bumps", lambda b: b)
+    monkeypatch.setattr(diagnose, "_sig_head", lambda *_: 1e-3)
+    monkeypatch.setattr(diagnose, "fit_hypothesis", lambda h, p, r, s, fb, w: fit(h, fb))
+    scrub = fit(Hypothesis((catalog_law("scrub", "labmate"),)), [])
+    single = fit(Hypothesis((catalog_law("bumps", "labmate"),)), spots)
+    channels = SimpleNamespace(channels=list)
+    ds = SimpleNamespace(mode="truth", prs=[], items=[channels])
+    rk = SimpleNamespace(
+        best=scrub, singles=[single], prob=SimpleNamespace(items=[]), proposals={}, cands=[]
+    )
+    assert diagnose._bumps_beside(ds, SimpleNamespace(fit=[]), rk) is taken
+    assert (rk.best.hyp.has_bumps and rk.best.bumps == spots) is taken
+    assert ("the floor bumps" in rk.proposals) is taken
 
 
 @pytest.mark.parametrize(
