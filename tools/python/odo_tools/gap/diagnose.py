@@ -824,6 +824,12 @@ def _on_excess_truck(
     return hs + [v for v in (hypotheses.on_truck(h, t, ds.prs[0].driven) for h in hs) if v]
 
 
+def _halves(r: float, r_was: float) -> bool:
+    """Whether track ratio r leaves at most TRACK_MEMBER_CUT of the excess misfit (R^2 - 1)
+    that r_was leaves: the rule a further member meets on the tracks."""
+    return r * r - 1.0 <= TRACK_MEMBER_CUT * (r_was * r_was - 1.0)
+
+
 def _member_joins(
     g: Fit,
     r: float,
@@ -839,7 +845,7 @@ def _member_joins(
     was not fitted to (`_track_cv`; `base` as `_track_fit`): a tiny Ed beside a scrub halved a
     LabMate's fitting tracks (R 2.13 -> 1.03) and made its held-out runs worse (dev seed 8
     case 6)."""
-    if r * r - 1.0 > TRACK_MEMBER_CUT * (r_was * r_was - 1.0):
+    if not _halves(r, r_was):
         return False
     cv = _track_cv(g.hyp, tp, prob, warm, base)
     return cv - 1.0 <= TRACK_MEMBER_CUT * (_track_cv(was, tp, prob, warm, base) - 1.0)
@@ -1022,11 +1028,11 @@ def _bumps_beside(ds: Dataset, sel: Selection, rk: Ranking, progress: Progress =
     ranks far below an effect that bends every arc, so a robot with both was named by that
     effect alone (independent world, dev seed 2604 case 5: a clapper's ramps and a scrub on
     truck B, "scrub", the held-out runs at 9.7 x the background). The bumps are detected under
-    the best's parameters and fitted beside them on the windows; they join where they leave at
-    most TRACK_MEMBER_CUT of the tracks' excess misfit (R^2 - 1), the rule a further member
-    meets on the tracks (True). The windows' BIC is not asked: it charges each bump two
-    parameters, and 2601 case 35's seven bumps beside a scrub lost 36 BIC there while taking the
-    tracks from 5.4 to 1.4 x (_bumps_on_tracks has the same reason)."""
+    the best's parameters and fitted beside them on the windows; they join where they halve the
+    tracks' excess misfit (`_halves`, the rule a further member meets on the tracks; True). The
+    windows' BIC is not asked: it charges each bump two parameters, and 2601 case 35's seven
+    bumps beside a scrub lost 36 BIC there while taking the tracks from 5.4 to 1.4 x
+    (_bumps_on_tracks has the same reason)."""
     best = rk.best
     if ds.mode != "truth" or best.hyp is None or best.hyp.has_bumps:
         return False
@@ -1047,7 +1053,7 @@ def _bumps_beside(ds: Dataset, sel: Selection, rk: Ranking, progress: Progress =
     if not _real(g):
         return False
     r = _track_ratio(g, rk.prob, ds, sel)
-    if r * r - 1.0 > TRACK_MEMBER_CUT * (rb * rb - 1.0):
+    if not _halves(r, rb):
         return False
     rk.proposals["the floor bumps"] = (
         f"the fitting runs' tracks sit at {rb:.1f} x the background under {best.name}; "
