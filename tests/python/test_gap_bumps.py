@@ -180,6 +180,50 @@ def test_weak_steps_alone_or_agreeing_too_faintly_are_dropped() -> None:
     assert bumps.confirm_weak(start) == []  # the start's transient, in every run at one spot
 
 
+@pytest.mark.parametrize("m", [40, 120])
+def test_the_step_detector_continues_a_run_by_its_mean_not_one_noisy_sample(m: int) -> None:
+    """A run's heading residual is continued past its ends (a bump in its first or last second is
+    seen too) by the mean of its first and last m / 4 samples, not by its end samples alone: one
+    sample carries the truth's whole heading noise, and a run continued by it showed a step of
+    that size at its start and end (dev seeds 4005-4007: LabMates with 0.2 deg of noise got
+    "bumps" at the origin every closed path starts and ends at, which then stood for the floor
+    there on the held-out runs). Pure noise with end samples six sigmas off shows no step there."""
+    rng = np.random.default_rng(3)
+    s = 1e-3
+    e = rng.normal(0.0, s, 40 * m)
+    e[0], e[-1] = 6 * s, -6 * s
+    D = bumps._step_detector(e, m)
+    ends = np.r_[D[: 2 * m], D[-2 * m :]]
+    assert np.abs(ends).max() < 3 * s  # continued by the end samples: 6 sigma
+
+
+@pytest.mark.parametrize("at", ["start", "end"])
+@pytest.mark.parametrize("off", [20, 10])
+def test_the_step_detector_sees_a_whole_step_in_a_runs_first_or_last_window(
+    at: str, off: int
+) -> None:
+    """A step m or m / 2 samples from either end of a run (a cable in its first or last second)
+    is seen at its full size where it is (continued by a whole window's mean, the one m / 2 from
+    an end came out at 7/8 of its size)."""
+    m, a = 20, 2e-3
+    e = np.zeros(30 * m)
+    k = off if at == "start" else e.size - off
+    e[k:] = a
+    D = bumps._step_detector(e, m)
+    assert int(np.argmax(np.abs(D))) == k
+    assert D[k] == pytest.approx(a, rel=1e-9)
+
+
+def test_a_cable_under_a_wide_labmate_is_named_bumps(tmp_path: Path) -> None:
+    """Independent world, dev seed 4006 case 34: a LabMate 548 mm wide crosses four cables (4-14
+    mm steps) with 0.2 deg of truth heading noise. With its runs continued by their noisy end
+    samples, an Ed was named (the held-out runs 7.6 -> 2.9 x the background, "ed"); continued
+    by their means, the cables are the bumps, and they close most of the held-out gap."""
+    _, rep = indep_named(4006, 34, tmp_path, "labmate", {"bumps": "steps"}, "bumps", "catalog")
+    hd = rep["heldout"]
+    assert hd["ratio_after"] < 0.5 * hd["ratio_before"]
+
+
 def test_a_floor_of_ramps_under_slow_wheels_is_named_bumps(tmp_path: Path) -> None:
     """Independent world, seed 2731 case 22: a slow LabMate over five cables across its wheel
     tracks (ramps of 4-20 mm). The tallest's heading step (0.012 rad) spreads over 0.75 s, which
