@@ -185,9 +185,9 @@ def test_the_step_detector_continues_a_run_by_its_mean_not_one_noisy_sample(m: i
     """A run's heading residual is continued past its ends (a bump in its first or last second is
     seen too) by the mean of its first and last m / 4 samples, not by its end samples alone: one
     sample carries the truth's whole heading noise, and a run continued by it showed a step of
-    that size at its start and end (dev seeds 4005-4007: LabMates with 0.2 deg of noise got
-    "bumps" at the origin every closed path starts and ends at, which then stood for the floor
-    there on the held-out runs). Pure noise with end samples six sigmas off shows no step there."""
+    that size at its start and end (dev seeds 4005 and 4006: a set and a clapper got "bumps" at
+    the origin every closed path starts and ends at, which then stood for the floor there on the
+    held-out runs). Pure noise with end samples six sigmas off shows no step there."""
     rng = np.random.default_rng(3)
     s = 1e-3
     e = rng.normal(0.0, s, 40 * m)
