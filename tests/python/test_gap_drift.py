@@ -2,8 +2,8 @@
 Ed, Eb and Es constant, so a wheel whose diameter grows as it warms - out of the catalog - is not
 "ed + es" however well a constant pair fits its held-out runs. The verdict's geometry is fitted
 run by run in the order the runs were recorded (stability.drift); a step between the runs of the
-same paths before and after one moment beyond verdict.DRIFT_Z standard errors makes the verdict
-"unexplained", with the finding in the report."""
+same paths (for the scale, the same shapes either way round) before and after one moment beyond
+verdict.DRIFT_Z standard errors makes the verdict "unexplained", with the finding in the report."""
 
 from __future__ import annotations
 
@@ -38,6 +38,20 @@ def test_a_diameter_that_grows_as_the_wheel_warms_is_unexplained(tmp_path: Path)
     assert f["param"] in ("es.value", "ed.value")
     assert f["z"] >= rep["thresholds"]["geometry_drift_z"]
     assert "drifts with time" in rep["verdict"]["reason"]
+
+
+def test_a_warming_wheel_is_seen_across_squares_driven_either_way(tmp_path: Path) -> None:
+    """Independent world, dev seed 4005 case 23: a LabMate drove three cw squares, a circle, three
+    ccw squares and a figure eight while its wheels warmed. Run by run Es rose 1.0006, 1.0026,
+    1.0035 on the cw squares and 1.0056, 1.0061, 1.0065 on the ccw ones, but no path had runs on
+    both sides of any moment, and "ed" was named. The scale is compared between shapes (a
+    square either way round), the verdict's heading parameters between paths."""
+    rep = _diagnose(4005, 23, tmp_path, {"diameter_drift": "thermal"})
+    assert rep["verdict"]["effect"] == "unexplained", rep["verdict"]
+    (f,) = [f for f in rep["stability"]["findings"] if f["kind"] == "time"]
+    assert f["param"] == "es.value", f
+    assert f["z"] >= rep["thresholds"]["geometry_drift_z"]
+    assert f["values"][1] > f["values"][0], f  # the wheels grew
 
 
 def test_a_constant_ed_holds_still_run_by_run(tmp_path: Path) -> None:
