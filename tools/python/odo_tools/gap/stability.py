@@ -180,13 +180,13 @@ def drift(items: list, prs: list[Prepared], sigma: np.ndarray, verdict: Fit) -> 
         # (a load that moves to the outer wheel). A warming wheel's Es rose 1.0006 -> 1.0035 on
         # three cw squares, then 1.0056 -> 1.0065 on three ccw squares (dev seed 4005 case 23):
         # no path on both sides, and "ed" was named.
-        same = (lambda pr: pr.shape) if k.split(".")[0] == "es" else (lambda pr: pr.path)
+        same = [r[0].shape if k.split(".")[0] == "es" else r[0].path for r in runs]
         for j in range(1, len(runs)):
-            common = {same(r[0]) for r in runs[:j]} & {same(r[0]) for r in runs[j:]}
+            common = set(same[:j]) & set(same[j:])
             if not common:
                 continue
-            early = [r for r in runs[:j] if same(r[0]) in common]
-            late = [r for r in runs[j:] if same(r[0]) in common]
+            early = [r for r, g in zip(runs[:j], same[:j], strict=True) if g in common]
+            late = [r for r, g in zip(runs[j:], same[j:], strict=True) if g in common]
             (a, sa), (b, sb) = _wmean(early), _wmean(late)
             z = abs(a - b) / max(math.hypot(sa, sb), 1e-12)
             if best is None or z > best.z:
