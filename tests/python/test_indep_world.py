@@ -280,6 +280,22 @@ def test_decoders_count_every_edge_below_their_rate_and_lose_counts_above() -> N
     assert np.all(np.diff(p) > 0) and p[0] < 2e-6 and abs(p[2] - 0.01) < 1e-12
 
 
+def test_accel_slip_spins_when_speeding_up_and_drags_when_slowing_either_way() -> None:
+    """The accel law's stated physics in both directions of travel: a wheel speeding up covers
+    less floor than it rolled, one slowing down more, whether it runs forwards or backwards."""
+    k1, p, cap = 0.05, 2.0, 0.3
+    for sign in (1.0, -1.0):
+        ds = np.full(4, sign * 2.0)
+        speeding_up = laws.slip_accel(ds, np.full(4, sign * 2000.0), k1, p, cap)
+        slowing = laws.slip_accel(ds, np.full(4, -sign * 2000.0), k1, p, cap)
+        kap = k1 * 2.0**p
+        assert np.allclose(np.abs(speeding_up), 2.0 * (1.0 - kap))
+        assert np.allclose(np.abs(slowing), 2.0 * (1.0 + kap))
+        assert np.all(np.sign(speeding_up) == sign) and np.all(np.sign(slowing) == sign)
+    hard = laws.slip_accel(np.ones(1), np.full(1, 50_000.0), k1, p, cap)
+    assert hard[0] == pytest.approx(1.0 - cap)
+
+
 def test_count_loss_only_loses_counts_above_its_rate(tmp_path: Path) -> None:
     """In the world: a straight that accelerates through the decoder's rate. Per tick the
     counted travel equals the true travel where the encoder's edge rate is below f_max and is

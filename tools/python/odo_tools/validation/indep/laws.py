@@ -52,9 +52,12 @@ def play(x: np.ndarray, y0: np.ndarray, half: float) -> np.ndarray:
 def slip_accel(ds, acc, k1, p, cap):
     """Longitudinal slip tied to the wheel's acceleration: slip ratio k1 (|a| / 1 m/s^2)^p,
     capped; the wheel spins (true travel short) when it speeds up, drags when it slows down.
-    ds: rolled distance per substep; acc: wheel surface acceleration (mm/s^2)."""
+    ds: rolled distance per substep; acc: wheel surface acceleration (mm/s^2). The slip takes
+    travel off in the direction the torque pushes (sign of acc), so a wheel speeding up
+    backwards also falls short; a sign(ds) factor here once made reversing wheels run long
+    when speeding up and short when slowing (half of every spot turn, every shuttle's return)."""
     kap = np.minimum(cap, k1 * (np.abs(acc) / 1000.0) ** p)
-    return ds - np.sign(acc) * np.sign(ds) * kap * np.abs(ds)
+    return ds - np.sign(acc) * kap * np.abs(ds)
 
 
 def traction(vw, vg0, alim, dt):
