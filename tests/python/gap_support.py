@@ -52,7 +52,7 @@ def indep_case(seed: int, k: int, out: Path, vehicle: str, laws: dict) -> dict:
     draws and simulates it; the drawn vehicle and effect laws are checked first, so a change of
     the world that moves the case fails here, by name, rather than in what a test asserts."""
     import numpy as np
-    from odo_tools.validation import indep
+    from odo_tools.validation import case_seed, indep
 
     rng = np.random.default_rng(seed)
     c = [indep.draw_case(rng, i) for i in range(k + 1)][k]
@@ -60,7 +60,7 @@ def indep_case(seed: int, k: int, out: Path, vehicle: str, laws: dict) -> dict:
         f"the independent world's seed {seed} case {k} changed ({c['vehicle']}, {c['laws']}): "
         "pick another case like it"
     )
-    indep.simulate_case(c, out, seed * 1000 + k)
+    indep.simulate_case(c, out, case_seed(seed, k))
     return c
 
 
@@ -83,7 +83,7 @@ def sim_case(seed: int, k: int, out: Path, vehicle: str, effects: list) -> dict:
     """The simulator world's case k of `seed`, simulated into `out` as `odo-gap blind --world
     sim` draws and simulates it; the drawn vehicle and effects are checked first (indep_case)."""
     import numpy as np
-    from odo_tools.validation import blind
+    from odo_tools.validation import blind, case_seed
 
     rng = np.random.default_rng(seed)
     c = [blind.draw_case(rng, i) for i in range(k + 1)][k]
@@ -91,5 +91,5 @@ def sim_case(seed: int, k: int, out: Path, vehicle: str, effects: list) -> dict:
         f"the simulator world's seed {seed} case {k} changed ({c['vehicle']}, {c['effects']}): "
         "pick another case like it"
     )
-    blind.simulate_case(c, out, seed * 1000 + k)
+    blind.simulate_case(c, out, case_seed(seed, k))
     return c

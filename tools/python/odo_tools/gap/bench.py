@@ -161,6 +161,7 @@ def main(argv: list[str] | None = None) -> int:
         ap.error(f"--cases {a.cases!r}: expected K or S:K items separated by commas")
     if not ks or min(min(sk) for sk in ks) < 0 or a.seed < 0 or a.rtol < 0:
         ap.error("--cases, --seed and --rtol must be non-negative (and --cases non-empty)")
+    from ..validation import case_seed
     from ..validation.blind import modes_of, world
     from .repo import source_dir
 
@@ -181,7 +182,7 @@ def main(argv: list[str] | None = None) -> int:
             c.setdefault("world", a.world)
             real = Path(tmp) / f"case-{seed}-{k:03d}"
             t0 = time.perf_counter()
-            simulate(c, real, seed * 1000 + k)  # the blind check's data seed
+            simulate(c, real, case_seed(seed, k))
             modes = list(modes_of(c["vehicle"]))
             print(
                 f"case {seed}:{k}: {c['vehicle']} {c.get('tick_ms', '')} ms, generated in "

@@ -30,6 +30,7 @@ from ..gap.errors import GapInputError
 from ..gap.io import ID_LINEAR, ID_ROTARY, ID_WHEEL, encode_payload, source_dir, write_candump
 from ..gap.simlib import Event, Opts, Result, RowEx, lib
 from ..outpath import OutDir, OutputError
+from . import case_seed
 
 BLIND_TOOL = "odo-gap blind"
 
@@ -417,7 +418,7 @@ def run_blind(
             for c in cases:
                 c.setdefault("world", w)
                 real = data / w / f"case-{c['case']:03d}" / "real"
-                key = simulate(c, real, seed * 1000 + c["case"])
+                key = simulate(c, real, case_seed(seed, c["case"]))
                 c.update(key or {})
                 c["accuracy_stated"] = (real / "instrument.json").is_file()
                 (tmp / w / "keys" / f"case-{c['case']:03d}.json").write_text(

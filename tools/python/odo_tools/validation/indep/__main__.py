@@ -10,6 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .. import case_seed
 from . import draw_case, simulate_case
 
 
@@ -99,7 +100,7 @@ def main(argv: list[str] | None = None) -> int:
     if not a.quiet:
         print(f"case {a.case} (seed {a.seed}): {case['vehicle']}, {len(case['plan'])} runs, "
               f"{case['tick_ms']} ms cycle", file=sys.stderr)
-    extra = simulate_case(case, a.out, seed=a.seed * 1_000_003 + a.case, progress=progress)
+    extra = simulate_case(case, a.out, seed=case_seed(a.seed, a.case), progress=progress)
     if not a.quiet:
         print(f"\rwrote {a.out}: {len(extra['runs'])} runs in {extra['generation_s']:.1f} s",
               file=sys.stderr)

@@ -17,6 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .. import case_seed
 from . import draw_case, simulate_case
 
 
@@ -32,7 +33,7 @@ def main(argv: list[str] | None = None) -> int:
         for k in range(a.cases):
             case = draw_case(rng, k)
             w0, c0 = time.perf_counter(), time.process_time()
-            extra = simulate_case(case, Path(tmp) / f"case-{k:03d}", a.seed * 1_000_003 + k)
+            extra = simulate_case(case, Path(tmp) / f"case-{k:03d}", case_seed(a.seed, k))
             wall, cpu = time.perf_counter() - w0, time.process_time() - c0
             robot_s = sum(r["duration_s"] for r in extra["runs"])
             rows.append({"case": k, "vehicle": case["vehicle"], "tick_ms": case["tick_ms"],
