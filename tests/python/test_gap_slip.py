@@ -227,3 +227,19 @@ def test_traction_limit_is_started_below_the_runs_demand(tmp_path: Path) -> None
     assert h["ratio_after"] < 0.25 * h["ratio_before"]
     a = v["params"]["slip@traction.a_max_m_s2"]
     assert a == pytest.approx(c["true"]["effects"]["slip"]["a_lim_m_s2"], rel=0.25)
+
+
+def test_accel_slip_is_named_from_return_errors(tmp_path: Path) -> None:
+    """Independent world, dev seed 4021 case 26: a LabMate (b 800 mm, 100 ms cycle) whose tyres
+    slip by a power (1.87) of their acceleration. From its return errors alone the catalog's and
+    the traction laws closed none of the squares' gap, an Eb half of it with a circle 40 mm off
+    ("unexplained" at 7.9 x the spread of repeated runs). The acceleration law is tried in
+    returns mode too, and names it."""
+    from odo_tools.gap.diagnose import diagnose
+
+    real = tmp_path / "real"
+    indep_case(4021, 26, real, "labmate", {"slip": "accel"})
+    rep = diagnose(real, real / "robot.json", mode="returns").to_dict()
+    v = rep["verdict"]
+    assert v["effect"] == "slip", v
+    assert v["laws"]["slip"]["law"] == "accel", v["laws"]
