@@ -64,9 +64,10 @@ def test_the_skid_laws_are_tried_unproposed_and_join_no_pair_unproposed() -> Non
     """hypotheses.tried_laws: without a proposal a ranking fits the load law, the cornering
     skid, the friction circle (a skid read on the straights after the arcs proposes nothing:
     independent 2951 case 30), Ed's speed law and slip's traction laws beside the catalog's
-    laws; returns mode, which cannot see a skid, gets no skid law; a proposed family brings
-    every one of its laws. An unproposed law is no partner (hypotheses.unproposed): the friction
-    circle, which limits starts as well as turns, once joined a LabMate's slip as a "skid"."""
+    laws; returns mode, which cannot see a skid, gets no skid law but slip's acceleration law
+    unproposed; a proposed family brings every one of its laws. An unproposed law is no partner
+    (hypotheses.unproposed): the friction circle, which limits starts as well as turns, once
+    joined a LabMate's slip as a "skid"."""
     from odo_tools.gap.hypotheses import tried_laws, unproposed
 
     def names(proposals: dict, mode: str = "truth", vehicle: str = "labmate") -> list[str]:
@@ -76,7 +77,8 @@ def test_the_skid_laws_are_tried_unproposed_and_join_no_pair_unproposed() -> Non
     skids = ["skid@cornering", "skid@friction"]
     assert names({}) == ["eb@load", *skids, "ed@growth", *traction]
     assert names({"skid": "arcs"}) == names({})
-    assert names({}, "returns") == ["eb@load", "ed@growth", *traction]
+    # from return errors, which propose nothing, the acceleration slip law too (4021 case 26)
+    assert names({}, "returns") == ["eb@load", "ed@growth", "slip@accel", *traction]
     assert "skid@cornering" not in names({}, "returns")
     # unproposed, the cornering law may lead alone but joins no pair (2721 case 13: "ed+skid")
     laws = {h.name: h for h in tried_laws({}, "truth", "set")}
