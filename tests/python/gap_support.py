@@ -65,14 +65,14 @@ def indep_case(seed: int, k: int, out: Path, vehicle: str, laws: dict) -> dict:
 
 
 def indep_named(seed: int, k: int, tmp: Path, vehicle: str, laws: dict, effect: str,
-                law: str) -> tuple[dict, dict]:
-    """indep_case k of `seed` diagnosed in truth mode: (the case, the report), after checking that
+                law: str, mode: str = "truth") -> tuple[dict, dict]:
+    """indep_case k of `seed` diagnosed in `mode`: (the case, the report), after checking that
     the verdict names `effect` and that its law is `law`."""
     from odo_tools.gap.diagnose import diagnose
 
     real = tmp / "real"
     c = indep_case(seed, k, real, vehicle, laws)
-    rep = diagnose(real, real / "robot.json", mode="truth").to_dict()
+    rep = diagnose(real, real / "robot.json", mode=mode).to_dict()
     v = rep["verdict"]
     assert v["effect"] == effect, v
     assert v["laws"][effect]["law"] == law, v["laws"]

@@ -10,7 +10,7 @@ from types import SimpleNamespace
 
 import numpy as np
 import pytest
-from gap_support import BUILD, SRC, indep_case
+from gap_support import BUILD, SRC, indep_case, indep_named
 
 
 @pytest.fixture(autouse=True)
@@ -235,11 +235,4 @@ def test_accel_slip_is_named_from_return_errors(tmp_path: Path) -> None:
     the traction laws closed none of the squares' gap, an Eb half of it with a circle 40 mm off
     ("unexplained" at 7.9 x the spread of repeated runs). The acceleration law is tried in
     returns mode too, and names it."""
-    from odo_tools.gap.diagnose import diagnose
-
-    real = tmp_path / "real"
-    indep_case(4021, 26, real, "labmate", {"slip": "accel"})
-    rep = diagnose(real, real / "robot.json", mode="returns").to_dict()
-    v = rep["verdict"]
-    assert v["effect"] == "slip", v
-    assert v["laws"]["slip"]["law"] == "accel", v["laws"]
+    indep_named(4021, 26, tmp_path, "labmate", {"slip": "accel"}, "slip", "accel", "returns")
