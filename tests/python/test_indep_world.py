@@ -13,7 +13,7 @@ from pathlib import Path
 import cantools
 import numpy as np
 import pytest
-from gap_support import PY, SRC, env
+from gap_support import PY, SRC, env, indep_case
 from odo_tools.gap import io
 from odo_tools.validation import indep
 from odo_tools.validation.indep import cases, floor, laws
@@ -504,13 +504,9 @@ def test_a_case_written_by_hand_is_the_case_blind_diagnosed(tmp_path: Path) -> N
     odo-gap blind simulates for case K of seed S (one data seed, validation.case_seed). The CLI
     once drew its noise from seed * 1000003 + K and the blind from seed * 1000 + K, so a miss
     traced by hand was another draw of the floor and the sensors than the one scored."""
-    from odo_tools.validation import case_seed
-
     seed, k = 4, 1
-    rng = np.random.default_rng(seed)
-    c = [indep.draw_case(rng, i) for i in range(k + 1)][k]
     ref = tmp_path / "blind"
-    indep.simulate_case(c, ref, case_seed(seed, k))
+    indep_case(seed, k, ref, "set", {})  # as odo-gap blind draws and simulates it
     out = tmp_path / "cli"
     r = subprocess.run([PY, "-m", "odo_tools.validation.indep", "--seed", str(seed), "--case",
                         str(k), "--out", str(out), "--quiet"], env=env(), capture_output=True,
