@@ -122,6 +122,36 @@ def test_a_spot_met_from_the_other_side_is_placed_and_one_already_placed_is_not(
     assert len(held.pr.bumps) == 1
 
 
+def test_a_spot_met_from_the_other_side_is_placed_by_its_middle() -> None:
+    # a cleat whose middle is at x = 1200, met by fitting runs rolling -x: the spot is the
+    # excess profile's middle, so a held-out wheel rolling +x starts that profile half of it
+    # before the closest sample (placed by its start, it began where the other runs' did, at
+    # the cleat's far side)
+    floor = [
+        {**_bump("ccw:1", ["run-ccw-02"], 1190.0, -198.0, way=np.pi), "half": 40.0},
+        {**_bump("outback:1", ["run-outback-01"], 1215.0, -205.0, way=np.pi), "half": 50.0},
+    ]
+    held = _run("cw:1")
+    bumps.place_floor_bumps([held], floor, min_runs=2)
+    assert len(held.pr.bumps) == 1
+    assert held.pr.bumps[0]["s0"] == pytest.approx(1200.0 - 45.0, abs=15.0)
+
+
+def test_a_bumps_events_are_clustered_by_their_middles() -> None:
+    # two runs fit one step, one higher (its profile longer): their starts 80 mm apart (two
+    # one-run bumps by the starts), their middles 50
+    ev = [
+        {"group": "cw:1", "truck": 0, "wheel": 0, "run": "run-cw-01", "s0": 1150.0, "half": 30.0,
+         "h": 4.0, "x_mm": 0.0, "y_mm": 0.0, "t_s": 1.0, "dir_rad": 0.0},
+        {"group": "cw:1", "truck": 0, "wheel": 0, "run": "run-cw-02", "s0": 1070.0, "half": 60.0,
+         "h": 16.0, "x_mm": 0.0, "y_mm": 0.0, "t_s": 1.0, "dir_rad": 0.0},
+    ]
+    (fb,) = bumps.cluster_bumps(ev)
+    assert fb["runs"] == ["run-cw-01", "run-cw-02"]
+    assert fb["s0"] + fb["half"] == pytest.approx(1155.0)  # the middles' median
+    assert fb["half"] == pytest.approx(45.0)
+
+
 def test_a_spot_its_own_path_agreed_on_is_left_to_the_path_placement() -> None:
     # the held-out run's own path has the bump from two runs: place_bumps puts it at its travel
     floor = [
@@ -233,6 +263,22 @@ def test_a_floor_of_ramps_under_slow_wheels_is_named_bumps(tmp_path: Path) -> No
     _, rep = indep_named(2731, 22, tmp_path, "labmate", {"bumps": "ramps"}, "bumps", "catalog")
     hd = rep["heldout"]
     assert hd["ratio_after"] < 0.6 * hd["ratio_before"]
+
+
+def test_a_step_is_met_where_its_middle_lies_by_a_path_crossing_it_elsewhere(
+    tmp_path: Path,
+) -> None:
+    """Independent world, dev seed 4031 case 19: a LabMate's paths cross three cleats (6-13 mm).
+    Floor bumps were placed on other paths by where the fitted excess profile starts, which for a
+    wheel coming another way is not where it meets the cleat: the held-out figure eight was
+    judged without the one every square crosses (its misfit 66570 -> 66570, the held-out runs
+    35.5 -> 8.0 x the background). By the profile's middle, the eight meets it too."""
+    _, rep = indep_named(4031, 19, tmp_path, "labmate", {"bumps": "steps"}, "bumps", "catalog")
+    hd = rep["heldout"]
+    eight = [(b["z2"], a["z2"]) for b, a in zip(hd["before"], hd["after"], strict=True)
+             if "eight" in b["run"]]
+    assert eight and all(a < 0.1 * b for b, a in eight)
+    assert hd["ratio_after"] < 0.1 * hd["ratio_before"]
 
 
 def test_a_faint_cable_every_square_crosses_is_found_from_its_runs_together(

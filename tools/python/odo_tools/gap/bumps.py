@@ -1,6 +1,6 @@
 """Discrete bumps (truth mode): locate heading steps in the truth-minus-model heading, fit each
 with the exact rigid-wheel profile (004 Eqs. 1-5, host_sim bump.c `exact`), and cluster the events
-of runs of one path at one wheel travel into floor bumps."""
+of runs of one path at one wheel travel into floor bumps; a bump's spot is its middle."""
 
 from __future__ import annotations
 
@@ -10,7 +10,7 @@ from typing import NamedTuple
 import numpy as np
 from scipy.optimize import least_squares
 
-from .model import Prepared, bump_dd, bump_excess
+from .model import Prepared, bump_dd, bump_excess, bump_span
 from .paths import group_key
 
 
@@ -156,7 +156,10 @@ class _Scan:
 
     def _event(self, w: int, s0: float, h: float, z: float) -> dict:
         pr, t = self.pr, self.truck
-        j = int(np.clip(np.searchsorted(self.Sa[w], s0), 0, self.tt.size - 1))
+        # the spot of the floor is the bump's middle: a wheel meeting it from the other side
+        # starts its excess at the far edge
+        half = 0.5 * bump_span(pr.R[t], h) if h > 0 else 0.0
+        j = int(np.clip(np.searchsorted(self.Sa[w], s0 + half), 0, self.tt.size - 1))
         xy = _contact(self.it.tpose[j, t], w, pr.b[t])
         return {
             "run": pr.run.name,
@@ -166,6 +169,7 @@ class _Scan:
             "wheel": w,
             "s0": float(s0),
             "h": float(h),
+            "half": float(half),
             "t_s": float(self.tt[j]),
             "x_mm": float(xy[0]),
             "y_mm": float(xy[1]),
@@ -295,10 +299,11 @@ def cluster_bumps(events: list[dict], tol_mm: float = 80.0) -> list[dict]:
     out = []
     keyf = lambda e: (e["group"], e["truck"], e["wheel"])  # noqa: E731
     for key in sorted({keyf(e) for e in events}):
-        evs = sorted((e for e in events if keyf(e) == key), key=lambda e: e["s0"])
+        mid = lambda e: e["s0"] + e.get("half", 0.0)  # noqa: E731
+        evs = sorted((e for e in events if keyf(e) == key), key=mid)
         cur: list[dict] = []
         for e in [*evs, None]:
-            if e is not None and (not cur or e["s0"] - cur[-1]["s0"] < tol_mm):
+            if e is not None and (not cur or mid(e) - mid(cur[-1]) < tol_mm):
                 cur.append(e)
                 continue
             if cur:
@@ -307,7 +312,11 @@ def cluster_bumps(events: list[dict], tol_mm: float = 80.0) -> list[dict]:
                         "group": key[0],
                         "truck": key[1],
                         "wheel": key[2],
-                        "s0": float(np.median([c["s0"] for c in cur])),
+                        "s0": float(
+                            np.median([mid(c) for c in cur])
+                            - np.median([c.get("half", 0.0) for c in cur])
+                        ),
+                        "half": float(np.median([c.get("half", 0.0) for c in cur])),
                         "h": float(np.median([c["h"] for c in cur])),
                         "x_mm": float(np.median([c["x_mm"] for c in cur])),
                         "y_mm": float(np.median([c["y_mm"] for c in cur])),
@@ -379,6 +388,7 @@ def floor_features(floor_bumps: list[dict]) -> list[dict]:
             )
     for f in feats:
         f["h"] = float(np.median([m["h"] for m in f["members"]]))
+        f["half"] = float(np.median([m.get("half", 0.0) for m in f["members"]]))
     return feats
 
 
@@ -418,7 +428,7 @@ def place_floor_bumps(items: list, floor_bumps: list[dict], min_runs: int) -> No
                     roll = _rolling(it, t, w, j)
                     if not any(_same_way(roll + a, f["dir_rad"]) for a in (0.0, math.pi)):
                         continue
-                    s0 = float(np.interp(it.tt[j], pr.t, pr.S[:, t, w]))
+                    s0 = float(np.interp(it.tt[j], pr.t, pr.S[:, t, w])) - f["half"]
                     if any(
                         o["truck"] == t and o["wheel"] == w and abs(o["s0"] - s0) < BUMP_SPAN_MM
                         for o in pr.bumps

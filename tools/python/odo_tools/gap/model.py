@@ -114,6 +114,12 @@ LIMIT_TOL_MM = 1.0
 # ------------------------------------------------------------------------------------------------
 # bump geometry (004 Eqs. 1-5, host_sim/src/bump.c 'exact': pivot about the step's edge)
 # ------------------------------------------------------------------------------------------------
+def bump_span(R: float, h: float) -> float:
+    """Wheel travel from first contact to the end of one bump's excess (bump_excess)."""
+    h = min(max(h, 1e-9), 0.999 * R)
+    return 2.0 * R * math.acos(1.0 - h / R)
+
+
 def bump_dd(R: float, h: np.ndarray | float) -> np.ndarray:
     """Excess rotation arc over horizontal travel for one whole bump: 2 (R psi0 - D_hor)."""
     h = np.clip(np.asarray(h, dtype=float), 0.0, 0.999 * R)
@@ -226,8 +232,7 @@ def floor_travel(
         w = ev["wheel"]
         S = pr.S[:, truck, w]
         # the excess only grows while the wheel's travel is inside the bump's span
-        h = min(max(ev["h"], 1e-9), 0.999 * R)
-        span = 2.0 * R * math.acos(1.0 - h / R)
+        span = bump_span(R, ev["h"])
         i0 = max(int(np.searchsorted(S, ev["s0"], side="right")) - 1, 0)
         i1 = min(int(np.searchsorted(S, ev["s0"] + span, side="left")), S.size - 1)
         if i1 <= i0:
