@@ -298,8 +298,8 @@ def cluster_bumps(events: list[dict], tol_mm: float = 80.0) -> list[dict]:
     """Events of runs on the same path at the same wheel travel are one floor bump."""
     out = []
     keyf = lambda e: (e["group"], e["truck"], e["wheel"])  # noqa: E731
+    mid = lambda e: e["s0"] + e.get("half", 0.0)  # noqa: E731
     for key in sorted({keyf(e) for e in events}):
-        mid = lambda e: e["s0"] + e.get("half", 0.0)  # noqa: E731
         evs = sorted((e for e in events if keyf(e) == key), key=mid)
         cur: list[dict] = []
         for e in [*evs, None]:
