@@ -516,6 +516,47 @@ def test_a_session_whose_runs_disagree_keeps_only_long_latencies() -> None:
     assert out["r9"] == 0.070
 
 
+def _own_clock(prs, off_s: float) -> None:
+    """Give the fake runs a truth sampled `off_s` after each count tick (0: at the ticks)."""
+    from types import SimpleNamespace
+
+    for pr in prs:
+        pr.t = np.arange(10) * pr.dt[0]
+        pr.run.truth = SimpleNamespace(t_s=pr.t[:-1] + off_s)
+
+
+def test_a_truth_on_its_own_clock_keeps_the_runs_median_where_they_disagree() -> None:
+    """The independent world's dev seed 4071 case 19, a LabMate with no effect whose motion
+    capture ran 14 ms late on 25 ms ticks: its runs read 9.5-24 ms, no one clock. Set to none,
+    slip took the lateness and the diagnosis called the robot "unexplained". A truth on its
+    own clock takes the runs' median instead; one taken at the ticks keeps none, and a clock
+    the scan under slip chose still wins."""
+    from odo_tools.gap.instrument import one_clock, session_latencies
+
+    lat = [0.0099, 0.0117, None, 0.0196, 0.0095, 0.0239, None]
+    prs, found = _runs(lat, tick=0.025)
+    assert one_clock(prs, {k: v for k, v in found.items() if v is not None}) == {"s": False}
+    _own_clock(prs, 0.0)
+    assert set(session_latencies(prs, found).values()) == {0.0}
+    _own_clock(prs, 0.004)
+    assert list(session_latencies(prs, found).values()) == pytest.approx([0.0117] * 7)
+    assert set(session_latencies(prs, found, 0.015).values()) == {0.015}
+
+
+def test_a_late_motion_capture_is_no_gap_on_a_robot_with_none(tmp_path: Path) -> None:
+    """The same case diagnosed: each run keeps the median read, the scan under slip finds a
+    clock of 15 ms (the truth's 14 ms), and the robot with no effect has no significant gap."""
+    from odo_tools.gap.diagnose import diagnose
+
+    real = tmp_path / "real"
+    c = indep_case(4071, 19, real, "labmate", {})
+    assert c["fidelity"]["truth_latency_s"] == pytest.approx(0.014, abs=5e-4)
+    rep = diagnose(real, real / "robot.json", mode="truth").to_dict()
+    assert rep["verdict"]["effect"] == "no significant gap", rep["verdict"]
+    lat = rep["instrument"]["latency_s"]
+    assert all(abs(v - 0.014) < 0.004 for v in lat.values()), lat
+
+
 def test_a_weak_gap_both_sides_see_and_nothing_closes_is_unexplained(tmp_path: Path) -> None:
     """The independent world's dev seed 2821 case 14: a LabMate with gear backlash (out of the
     catalog). Its held-out runs sit at 1.5-2 x the background, its fitting runs' nominal tracks
