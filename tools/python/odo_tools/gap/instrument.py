@@ -36,7 +36,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from .model import Prepared, dead_reckon, track_at
-from .modes import WINDOW_S, Instrument, _body_inc, to_centre
+from .modes import WINDOW_S, Instrument, _body_inc, on_ticks, to_centre
 
 LATENCY_MAX_S = 0.5
 LATENCY_STEP_S = 0.005
@@ -393,11 +393,7 @@ def own_clock(pr: Prepared) -> bool:
     """Whether a run's truth keeps a clock of its own: samples off the count ticks (a motion
     capture), which is always some time late, rather than a truth taken at the ticks."""
     tr = getattr(pr.run, "truth", None)
-    if tr is None or tr.t_s.size == 0:
-        return False
-    k = np.clip(np.searchsorted(pr.t, tr.t_s), 1, pr.t.size - 1)
-    off = np.minimum(np.abs(tr.t_s - pr.t[k - 1]), np.abs(tr.t_s - pr.t[k]))
-    return bool(np.any(off > 1e-6))
+    return tr is not None and not on_ticks(tr.t_s, pr.t)
 
 
 def lever_arm(

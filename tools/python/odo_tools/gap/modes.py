@@ -113,6 +113,14 @@ def to_centre(
     return out
 
 
+def on_ticks(tt: np.ndarray, t: np.ndarray) -> bool:
+    """Whether every time of tt (s) falls on one of the count ticks t (within 1 us)."""
+    if tt.size == 0:
+        return True
+    k = np.clip(np.searchsorted(t, tt), 1, t.size - 1)
+    return bool(np.all(np.minimum(np.abs(tt - t[k - 1]), np.abs(tt - t[k])) <= 1e-6))
+
+
 def spot_ticks(pr: Prepared) -> np.ndarray:
     """(n-1, trucks): ticks whose wheels roll opposite ways (a turn on the spot)."""
     return (pr.ds[:, :, 0] * pr.ds[:, :, 1]) < 0.0
@@ -232,9 +240,7 @@ class TruthMode:
         self._je = np.searchsorted(self._ends, self.j)
         # whether every truth sample (after its latency) falls on a count tick: the model is
         # then compared where it is known, with no interpolation between ticks
-        kt = np.clip(np.searchsorted(pr.t, self.tt), 1, pr.t.size - 1)
-        gap = np.minimum(np.abs(self.tt - pr.t[kt - 1]), np.abs(self.tt - pr.t[kt]))
-        self.exact = bool(np.all(gap <= 1e-6))
+        self.exact = on_ticks(self.tt, pr.t)
         # the model at the truth's samples and at the windows' ends (model.TrackAt): between
         # ticks a cubic through them; a truth taken at the ticks needs no interpolation
         self._at_all = TrackAt(self.tt, pr.t, self.exact)
