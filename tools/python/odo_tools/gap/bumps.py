@@ -307,16 +307,14 @@ def cluster_bumps(events: list[dict], tol_mm: float = 80.0) -> list[dict]:
                 cur.append(e)
                 continue
             if cur:
+                half = float(np.median([c.get("half", 0.0) for c in cur]))
                 out.append(
                     {
                         "group": key[0],
                         "truck": key[1],
                         "wheel": key[2],
-                        "s0": float(
-                            np.median([mid(c) for c in cur])
-                            - np.median([c.get("half", 0.0) for c in cur])
-                        ),
-                        "half": float(np.median([c.get("half", 0.0) for c in cur])),
+                        "s0": float(np.median([mid(c) for c in cur])) - half,
+                        "half": half,
                         "h": float(np.median([c["h"] for c in cur])),
                         "x_mm": float(np.median([c["x_mm"] for c in cur])),
                         "y_mm": float(np.median([c["y_mm"] for c in cur])),

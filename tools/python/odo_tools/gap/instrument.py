@@ -376,9 +376,9 @@ def session_latencies(
     for same in by.values():
         clock = _clock([out[pr.run.name] for pr in same], tick)
         short = unfixed
-        fixed = [found[pr.run.name] for pr in same if found.get(pr.run.name) is not None]
-        if not unfixed and fixed and all(own_clock(pr) for pr in same):
-            short = float(np.median(fixed))
+        if clock is None and not unfixed and all(own_clock(pr) for pr in same):
+            fixed = [found[pr.run.name] for pr in same if found.get(pr.run.name) is not None]
+            short = float(np.median(fixed)) if fixed else unfixed
         for pr in same:
             L = out[pr.run.name]
             if clock is not None:
