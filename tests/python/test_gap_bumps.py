@@ -427,7 +427,50 @@ def test_bumps_replace_the_best_only_where_they_halve_what_the_tracks_keep(
         singles=[single],
         proposals={},
         prob=None,
+        bumps_other=None,
     )
     assert diagnose._bumps_on_tracks(SimpleNamespace(mode="truth"), None, rk) is taken
     assert (rk.best is single) is taken
     assert ("the accumulated track" in rk.proposals) is taken
+
+
+@pytest.mark.parametrize(("other_ratio", "named"), [(1.48, "other"), (3.6, None), (3.2, "single")])
+def test_the_tracks_judge_both_detections_of_the_floor_bumps(
+    monkeypatch: pytest.MonkeyPatch, other_ratio: float, named: str | None
+) -> None:
+    """diagnose._bumps_on_tracks weighs the bumps single with the windows' detection and with
+    the other one (Ranking.bumps_other), and names the one that leaves the fitting runs'
+    tracks closer, shown in the ranking in place of the other. Ratios of dev seed 4061 case 4
+    (nominal 3.89, the windows' best 6.52, their detection 3.40, the other 1.48); where neither
+    halves the tracks' excess, neither is named."""
+    from odo_tools.gap import diagnose
+    from odo_tools.gap.hypotheses import Hypothesis, catalog_law
+
+    def fit(name: str, fam: str | None, floor: list, bic: float) -> SimpleNamespace:
+        hyp = Hypothesis((catalog_law(fam, "labmate"),)) if fam else None
+        return SimpleNamespace(name=name, hyp=hyp, bumps=floor, bic=bic)
+
+    single = fit("bumps", "bumps", [_bump("cw:1", ["run-cw-01"], 1000.0, 0.0)], 2617.9)
+    other = fit("bumps", "bumps", [_bump("ccw:1", ["run-ccw-02"], 5140.0, 0.0)], 2618.9)
+    best = fit("scrub+slip", "slip", [], 2300.0)
+    ratios = {id(single): 3.40 if named != "single" else 1.3, id(other): other_ratio}
+    ratios[id(best)] = 6.52
+    null = fit("nominal", None, [], 2650.0)
+    ratios[id(null)] = 3.89
+    monkeypatch.setattr(diagnose, "_track_ratio", lambda f, *_: ratios[id(f)])
+    rk = SimpleNamespace(
+        null=null,
+        best=best,
+        singles=[best, single],
+        cands=[best, single],
+        proposals={},
+        prob=None,
+        bumps_other=other,
+    )
+    taken = diagnose._bumps_on_tracks(SimpleNamespace(mode="truth"), None, rk)
+    assert taken is (named is not None)
+    want = {"other": other, "single": single, None: best}[named]
+    assert rk.best is want
+    shown = other if named == "other" else single
+    assert [f for f in rk.singles if f.name == "bumps"] == [shown]
+    assert [f for f in rk.cands if f.name == "bumps"] == [shown]
