@@ -131,21 +131,3 @@ def test_a_truth_late_behind_slipping_counts_finds_its_clock(tmp_path: Path) -> 
     lat = statistics.median(rep["instrument"]["latency_s"].values())
     assert lat == pytest.approx(c["fidelity"]["truth_latency_s"], abs=0.008)
     assert rep["heldout"]["ratio_after"] < 0.5 * rep["heldout"]["ratio_before"]
-
-
-def test_the_clock_is_screened_under_each_slip_law_near_the_top(tmp_path: Path) -> None:
-    """Independent world, dev seed 4071 case 32: a LabMate's traction slip (0.83 m/s^2) on
-    50 ms ticks under a motion capture 13 ms late. Under the tick-level limiter, the first slip
-    law of the ranking, the clocks screen best at 20 ms, and the slip fitted there left the
-    held-out runs at 13.6 x the background, "unexplained"; under the limiter inside the tick
-    (the motor's lag) they screen best at 5 ms and 160 BIC lower. Screened under both, that
-    law and clock are taken and the slip is named, closing the held-out gap."""
-    from odo_tools.gap.diagnose import diagnose
-
-    real = tmp_path / "real"
-    indep_case(4071, 32, real, "labmate", {"slip": "traction"})
-    rep = diagnose(real, real / "robot.json", mode="truth").to_dict()
-    v = rep["verdict"]
-    assert v["effect"] == "slip", v
-    assert v["laws"]["slip"]["law"] == "motor", v["laws"]
-    assert rep["heldout"]["ratio_after"] <= 1.5
