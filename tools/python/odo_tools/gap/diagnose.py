@@ -1084,7 +1084,7 @@ def _bumps_on_tracks(ds: Dataset, sel: Selection, rk: Ranking, progress: Progres
     step of a few noise sigmas, and their choice under a truth retimed to slip lost a 5.6 mm
     ramp that both of its runs crossed and kept a step in one run that no other saw; the
     tracks then sat at 3.4 x under those bumps against 1.5 x under the other detection's
-    (independent world, dev seed 4061 case 4: "unexplained" for bumps)."""
+    (independent world, dev seed 4061 case 4, a LabMate's bumps: "unexplained" before)."""
     if ds.mode != "truth" or rk.best.hyp is None or rk.best.hyp.has_bumps:
         return False
     found = [f for f in rk.singles if f.name == "bumps" and f.bumps]
@@ -1224,9 +1224,7 @@ def _bumps_ref(singles: list[Fit]) -> Fit | None:
     )
 
 
-def _bumps_under_best(
-    singles: list[Fit], prob, fprs, sig_head
-) -> tuple[list | None, Fit | None]:
+def _bumps_under_best(singles: list[Fit], prob, fprs, sig_head) -> tuple[list | None, Fit | None]:
     """Floor bumps detected under the best other single (`_bumps_ref`), and the bumps single
     fitted with them too, kept where that explains the fitting runs better (`singles` re-sorted
     in place). The single detects under the nominal model, whose heading steps from a small Ed
