@@ -288,9 +288,9 @@ def test_a_member_the_tracks_do_not_need_leaves_the_pair(tmp_path, monkeypatch) 
     assert "the accumulated track" not in rep["proposals"]
     ask = D._slip_not_latency
 
-    def no_scan(ds, sel, ranked, best, cand=None) -> bool:
+    def no_scan(ds, sel, ranked, best, cand=None, others=()) -> bool:
         late = [i for i in sel.fit if ds.instrument.latency_s.get(ds.prs[i].run.name)]
-        return bool(late) and ask(ds, sel, ranked, best, cand)
+        return bool(late) and ask(ds, sel, ranked, best, cand, others)
 
     monkeypatch.setattr(D, "_slip_not_latency", no_scan)
     # the track fit of each truck's own geometry names the trailer's Ed before the pruning is
