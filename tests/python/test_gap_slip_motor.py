@@ -87,15 +87,22 @@ def test_traction_slip_inside_the_tick_is_named(tmp_path: Path) -> None:
     spins under a 0.94 m/s^2 traction limit. A limiter on the tick means left its held-out runs
     at 13 x the background ("unexplained"); inside the tick the slip is named, and it closes
     the held-out gap."""
+    rep = _slip_inside_the_tick(tmp_path, 2731, 24, "set")
+    assert rep["heldout"]["ratio_after"] < 0.5 * rep["heldout"]["ratio_before"]
+
+
+def _slip_inside_the_tick(tmp_path: Path, seed: int, k: int, vehicle: str) -> dict:
+    """The report of the independent world's traction-slip case k of `seed`, diagnosed with
+    truth, after checking that it names slip by the law inside the tick."""
     from odo_tools.gap.diagnose import diagnose
 
     real = tmp_path / "real"
-    indep_case(2731, 24, real, "set", {"slip": "traction"})
+    indep_case(seed, k, real, vehicle, {"slip": "traction"})
     rep = diagnose(real, real / "robot.json", mode="truth").to_dict()
     v = rep["verdict"]
     assert v["effect"] == "slip", v
     assert v["laws"]["slip"]["law"] == "motor", v["laws"]
-    assert rep["heldout"]["ratio_after"] < 0.5 * rep["heldout"]["ratio_before"]
+    return rep
 
 
 def test_every_other_law_has_words_and_units_in_the_report() -> None:
@@ -133,21 +140,14 @@ def test_a_truth_late_behind_slipping_counts_finds_its_clock(tmp_path: Path) -> 
     assert rep["heldout"]["ratio_after"] < 0.5 * rep["heldout"]["ratio_before"]
 
 
-def test_the_clock_is_screened_under_each_slip_law_near_the_top(tmp_path: Path) -> None:
+def test_the_clock_is_screened_under_both_resolutions_of_a_grip_limit(tmp_path: Path) -> None:
     """Independent world, dev seed 4071 case 32: a LabMate's traction slip (0.83 m/s^2) on
     50 ms ticks under a motion capture 13 ms late. Under the tick-level limiter, the first slip
     law of the ranking, the clocks screen best at 20 ms, and the slip fitted there left the
     held-out runs at 13.6 x the background, "unexplained"; under the limiter inside the tick
     (the motor's lag) they screen best at 5 ms and 160 BIC lower. Screened under both, that
     law and clock are taken and the slip is named, closing the held-out gap."""
-    from odo_tools.gap.diagnose import diagnose
-
-    real = tmp_path / "real"
-    indep_case(4071, 32, real, "labmate", {"slip": "traction"})
-    rep = diagnose(real, real / "robot.json", mode="truth").to_dict()
-    v = rep["verdict"]
-    assert v["effect"] == "slip", v
-    assert v["laws"]["slip"]["law"] == "motor", v["laws"]
+    rep = _slip_inside_the_tick(tmp_path, 4071, 32, "labmate")
     assert rep["heldout"]["ratio_after"] <= 1.5
 
 
