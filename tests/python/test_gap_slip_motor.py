@@ -168,7 +168,12 @@ def test_the_clock_is_screened_again_only_under_the_grip_limits_twin(
     resolution of one grip limit is screened. With the acceleration law beside catalog slip,
     the fresh seed 3161's case 36 (a floor roughness, truth 27.7 ms late) was screened at 20 ms
     under the acceleration law and named slip."""
+    from odo_tools.gap import hypotheses
     from odo_tools.gap.diagnose import limiter_twins
 
-    slips = [SimpleNamespace(name=n) for n in names]
+    laws = [h.laws[0] for h in hypotheses.singles("truth", "set") if h.families == ("slip",)]
+    laws += [h.laws[0] for h in hypotheses.other_laws("slip", "truth", "set")]
+    laws += [law.on("A") for law in list(laws)]
+    by_key = {law.key: law for law in laws}
+    slips = [SimpleNamespace(name=n, hyp=hypotheses.Hypothesis((by_key[n],))) for n in names]
     assert [f.name for f in limiter_twins(slips)] == twins

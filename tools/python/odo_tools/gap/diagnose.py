@@ -24,7 +24,7 @@ import functools
 import itertools
 import math
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import NamedTuple
@@ -1529,15 +1529,15 @@ SLIP_EARLY = 3  # a slip single this high among the singles is asked about laten
 # (_slip_not_latency's `others`). Not the laws proportional to acceleration: those take a
 # latency on every start, and the acceleration law screened a truth 27.7 ms late at 20 ms and
 # named the lateness slip (independent world, fresh seed 3161 case 36, a floor roughness)
-GRIP_LIMITERS = {"slip@traction", "slip@motor"}  # on one truck too ("slip@motor[A]")
+GRIP_LIMITERS = ("traction", "motor")  # slip's law names (hypotheses.OTHER_LAWS), any truck
 
 
-def limiter_twins(slips: list) -> list:
-    """The slips after the first (best BIC first) that are, with it, GRIP_LIMITERS laws."""
-    base = [f.name.split("[")[0] for f in slips]
-    if not base or base[0] not in GRIP_LIMITERS:
+def limiter_twins(slips: list[Fit]) -> list[Fit]:
+    """The slip singles after the first (best BIC first) that are, with it, GRIP_LIMITERS laws."""
+    grip = [f.hyp.laws[0].name in GRIP_LIMITERS for f in slips]
+    if not grip or not grip[0]:
         return []
-    return [f for f, b in zip(slips[1:], base[1:], strict=True) if b in GRIP_LIMITERS]
+    return [f for f, g in zip(slips[1:], grip[1:], strict=True) if g]
 
 
 # the one clock a truth may run behind the counts by, tried under a slip candidate; the
@@ -1555,7 +1555,7 @@ def _slip_not_latency(
     ranked: Problem,
     best: Fit,
     cand: Fit | None = None,
-    others: list[Fit] | tuple = (),
+    others: Sequence[Fit] = (),
 ) -> bool | None:
     """The converse of `_relatency`: runs given a latency - is the latency the robot's slip?
     The best candidate (plus catalog slip when it has none) is fitted on the items with one
@@ -1571,24 +1571,23 @@ def _slip_not_latency(
     problem `best` was ranked on; `cand`: the candidate to ask with instead of `best` (rank: the
     slip single, before any pair); `others`: further slip laws near the top (GRIP_LIMITERS's
     twin of `cand`), under which the clocks are screened too, the law and clock screened best
-    asked on (a tick-level traction
-    limit reads a truth 13 ms late on 50 ms ticks as 20 ms, a limit inside the tick with a
-    motor lag as 5 ms and 160 BIC better there; under the first the slip left the held-out
-    runs at 13.6 x the background, "unexplained", under the second at 1.3 x: independent
-    world, dev seed 4071 case 32). None: asked, and the answer is the clock the runs had (no
-    latency anywhere), so the items stand and there is nothing to rank again."""
+    asked on (a tick-level traction limit reads a truth 13 ms late on 50 ms ticks as 20 ms, a
+    limit inside the tick with a motor lag as 5 ms and 160 BIC better there; under the first the
+    slip left the held-out runs at 13.6 x the background, "unexplained", under the second at
+    1.3 x: independent world, dev seed 4071 case 32). None: asked, and the answer is the clock
+    the runs had (no latency anywhere), so the items stand and there is nothing to rank again."""
     if ds.mode != "truth" or ds.instrument is None or best.hyp is None:
         return False
     fprs = [ds.prs[i] for i in sel.fit]
     lat = [pr for pr in fprs if abs(ds.instrument.latency_s.get(pr.run.name, 0.0)) > 0]
-    if not lat and (ds.instrument.clock_scanned or all(ds.items[i].exact for i in sel.fit)):
-        return False
-
     # runs given no latency are asked too, once, where the truth keeps its own clock (samples
     # off the count ticks): where no run's track fixed its shift (a truth 15 ms late on 50 ms
     # ticks), slip took the clock, and a set with no effect went "unexplained" with slip best
     # (independent world, dev seed 2851 case 25). A truth on the ticks shares the robot's
     # clock (the simulator's: the scan added 9-18 s to its slip cases and changed no verdict)
+    if not lat and (ds.instrument.clock_scanned or all(ds.items[i].exact for i in sel.fit)):
+        return False
+
     def with_slip(f: Fit) -> hypotheses.Hypothesis:
         if "slip" in f.hyp.families:
             return f.hyp
@@ -1629,9 +1628,11 @@ def _slip_not_latency(
     # diagnosis' 44 s on one core (independent world, dev seed 2971 case 52; the second start
     # ended no better at any of its eight clocks). Only the clock chosen is fitted to the end,
     # from every start, and compared
+    def held_bumps(ask: Fit) -> list | None:
+        return ask.bumps if with_slip(ask).has_bumps and ask.bumps else None
+
     def scan(ask: Fit, clocks: tuple[float, ...]) -> dict[float, float]:
-        held = ask.bumps if with_slip(ask).has_bumps and ask.bumps else None
-        got = par.each([functools.partial(cost, ask, L, held, True) for L in clocks])
+        got = par.each([functools.partial(cost, ask, L, held_bumps(ask), True) for L in clocks])
         return dict(zip(clocks, got, strict=True))
 
     # the clock is looked for once (each point a fit); asked again (after the ranking, with
@@ -1646,8 +1647,7 @@ def _slip_not_latency(
     ds.instrument.clock_scanned = True
     screened = [(scan(a, grid), a) for a in asks]
     tried, ask = min(screened, key=lambda s: min(s[0].values()))
-    hyp = with_slip(ask)
-    held = ask.bumps if hyp.has_bumps and ask.bumps else None
+    held = held_bumps(ask)
     top = min(tried, key=lambda L: tried[L])
     if top:
         tried.update(scan(ask, (top - SLIP_CLOCK_REFINE_S, top + SLIP_CLOCK_REFINE_S)))
