@@ -349,6 +349,25 @@ FRICTION_LIMIT = "skid@friction.a_lim_m_s2"
 GRIP_LIMITS = (FRICTION_LIMIT, "slip@traction.a_max_m_s2", "slip@motor.a_max_m_s2")
 
 
+def grip_starts(keys: list[str], prs: list) -> list[dict]:
+    """Starts for the grip limits among `keys`. A grip limit above every demand the runs make
+    changes nothing (no gradient): it starts below the hardest demand the counts show, at three
+    depths. The traction laws started at 2 m/s^2 on a LabMate whose starts asked less: in
+    returns mode its slip went "unexplained" at 21 x the background, slip@traction at 3.4 x once
+    started below (independent world, seed 2981 case 24, traced after that seed was measured).
+    Those two laws get the starts only where their own start sits above the demand: on every
+    robot they cost 5-25 % more CPU per truth diagnosis (the friction circle's skid keeps them
+    always, as it was measured)."""
+    lim = [k for k in keys if k.startswith(GRIP_LIMITS)]
+    if not lim:
+        return []
+    from .model import accel_demand
+
+    peak = accel_demand(prs)
+    lim = [k for k in lim if k.startswith(FRICTION_LIMIT) or bounds(k)[2] >= peak]
+    return [{k: f * peak for k in lim} for f in (0.8, 0.5, 0.25)] if lim else []
+
+
 def fit_hypothesis(
     hyp: Hypothesis,
     prob: Problem,
@@ -378,23 +397,7 @@ def fit_hypothesis(
 
         for t in range(len(prs[0].b)):
             fixed[f"count_loss@plateau.level_mm_s.{'AB'[t]}"] = plateau_level(prs, t)
-    starts = []
-    lim = [k for k in keys if k.startswith(GRIP_LIMITS)]
-    if lim and warm is None:
-        # a grip limit above every demand the runs make changes nothing (no gradient): start it
-        # below the hardest demand the counts show, at three depths. The traction laws started
-        # at 2 m/s^2 on a LabMate whose starts asked less: in returns mode its slip went
-        # "unexplained" at 21 x the background, slip@traction at 3.4 x once started below
-        # (independent world, seed 2981 case 24, traced after that seed was measured). Those
-        # two laws get the starts only where their own start sits above the demand: on every
-        # robot they cost 5-25 % more CPU per truth diagnosis (the friction circle's skid keeps
-        # them always, as it was measured)
-        from .model import accel_demand
-
-        peak = accel_demand(prs)
-        lim = [k for k in lim if k.startswith(FRICTION_LIMIT) or bounds(k)[2] >= peak]
-        if lim:
-            starts += [{k: f * peak for k in lim} for f in (0.8, 0.5, 0.25)]
+    starts = grip_starts(keys, prs) if warm is None else []
     if not hyp.has_bumps:
         P, se = fit_params(prob, keys, fixed, warm=warm, bnd=bnd, starts=starts, tol=tol)
         return evaluate(prob, hyp.name, P, se, len(keys), hyp=hyp)
