@@ -37,6 +37,49 @@ def test_a_drifting_truth_clock_is_unexplained_with_its_rate(tmp_path: Path) -> 
     assert steps[0].startswith("stamp the truth with the robot's clock"), steps
 
 
+def test_a_skid_is_named_beside_a_clock_that_restamping_does_not_confirm(tmp_path: Path) -> None:
+    """Dev seed 4061 case 14: a LabMate whose floor gives 0.56 m/s^2 and whose truth keeps the
+    robot's time. Under the friction skid named (96 % of the held-out misfit removed) the runs'
+    thirds read +1879 ppm, seven of nine agreeing, and the verdict was "unexplained", the clock's.
+    The truth re-stamped by that rate leaves the skid more of the held-out misfit, not less
+    (diagnose._clock_confirmed): the skid stays named, the rate and the re-stamped misfit in
+    the report."""
+    from odo_tools.gap.diagnose import CLOCK_CONFIRM, diagnose
+    from odo_tools.gap.report import markdown
+
+    real = tmp_path / "real"
+    c = indep_case(4061, 14, real, "labmate", {"skid": "friction"})
+    assert "clock_drift" not in c["true"]["effects"]
+    rep = diagnose(real, real / "robot.json", mode="truth").to_dict()
+    assert rep["verdict"]["effect"] == "skid", rep["verdict"]
+    cr, h = rep["instrument"]["clock_rate"], rep["heldout"]
+    assert abs(cr["ppm"]) >= 8 * cr["se_ppm"] and abs(cr["ppm"]) > 1000, cr  # read drifting
+    assert cr["restamped_ratio_after"] ** 2 - 1 > CLOCK_CONFIRM * (h["ratio_after"] ** 2 - 1), cr
+    assert "not the clock's, and the verdict stands" in markdown(rep)
+
+
+def test_restamping_a_drifting_truth_by_its_rate_stops_the_drift(tmp_path: Path) -> None:
+    """instrument.restamped scales each run's truth time by 1 - ppm x 1e-6 from the run's
+    start (the next step the report gives): seed 2911 case 31's truth, re-stamped by the rate
+    its runs read, reads within a tenth of it, and the truth's first sample keeps its time."""
+    from odo_tools.gap import diagnose as D
+    from odo_tools.gap import instrument
+
+    real = tmp_path / "real"
+    indep_case(2911, 31, real, "labmate", {"clock_drift": "linear"})
+    ds = D.load(real, real / "robot.json", "truth")
+    cr = instrument.clock_rate(ds.prs, ds.instrument)
+    assert cr is not None and cr.drifting(), cr
+    prs = instrument.restamped(ds.prs, cr.ppm)
+    for a, b in zip(ds.prs, prs, strict=True):
+        assert b.run.truth.t_s[0] == a.run.truth.t_s[0]
+        span = a.run.truth.t_s[-1] - a.run.truth.t_s[0]
+        got = b.run.truth.t_s[-1] - b.run.truth.t_s[0]
+        assert got == pytest.approx(span * (1 - cr.ppm * 1e-6), abs=1e-6)  # epoch seconds
+    again = instrument.clock_rate(prs, ds.instrument)
+    assert abs(again.ppm) < 0.1 * abs(cr.ppm), again
+
+
 def test_an_es_reads_as_a_clock_on_the_nominal_model_only(tmp_path: Path) -> None:
     """Independent world, dev seed 2811 case 25: a set's trailer with a mean-diameter error and a
     truth clock that holds still. On the nominal model the runs' thirds read -420 ppm, seven of

@@ -185,3 +185,23 @@ def test_a_pair_whose_load_law_went_to_zero_is_fitted_as_the_catalog_pair() -> N
     assert _as_catalog(fit(0.0), "labmate").name == "eb+ed"
     assert _as_catalog(fit(0.0, "B"), "clapper").name == "eb[B]+ed"
     assert _as_catalog(fit(0.09), "labmate") is None
+
+
+def test_a_sets_marker_and_latency_are_read_beside_a_friction_skid(tmp_path: Path) -> None:
+    """Dev seed 4071 case 43: a set (50 ms tick) whose floor gives 0.21 m/s^2; its marker sits
+    on truck A's axle and the truth is 40 ms late. No spot turns, so the marker is read on arcs
+    under a preliminary fit with a skid (diagnose._lever_with_skid): under the cornering law
+    alone it read 207 mm behind the axle with the truth 125-168 ms late, and the friction skid
+    fitted then left the held-out runs at 31 x the background ("unexplained"). Read under the
+    friction circle too, the marker is near the axle, the latency near 40 ms, and the skid is
+    named with its limit; the truth's clock, read drifting under it, is no clock
+    (test_a_skid_is_named_beside_a_clock_that_restamping_does_not_confirm)."""
+    c, rep = indep_named(4071, 43, tmp_path, "set", {"skid": "friction"}, "skid", "friction")
+    inst = rep["instrument"]
+    assert np.hypot(*inst["lever_arm_mm"][0]) < 30.0, inst["lever_arm_mm"]
+    true_lat = c["fidelity"]["truth_latency_s"]
+    assert all(abs(x - true_lat) < 0.015 for x in inst["latency_s"].values()), inst["latency_s"]
+    true = c["true"]["effects"]["skid"]["a_lim_m_s2"]
+    assert rep["verdict"]["params"]["skid@friction.a_lim_m_s2"] == pytest.approx(true, rel=0.05)
+    h = rep["heldout"]
+    assert h["ratio_after"] ** 2 - 1 < 0.05 * (h["ratio_before"] ** 2 - 1), h

@@ -471,6 +471,9 @@ class ClockRate:
     runs: int
     of: int
     span_s: float  # the median run's duration
+    # the named candidate's held-out misfit (x the background) with the truth re-stamped by
+    # this rate (`restamped`; diagnose._clock_confirmed), None where not asked
+    restamped_ratio_after: float | None = None
 
     def drifting(self) -> bool:
         return (
@@ -478,6 +481,19 @@ class ClockRate:
             and abs(self.ppm) >= CLOCK_RATE_MIN_PPM
             and abs(self.ppm) >= CLOCK_RATE_Z * self.se_ppm
         )
+
+
+def restamped(prs: list[Prepared], ppm: float) -> list[Prepared]:
+    """The runs with their truth's time scaled by 1 - ppm x 1e-6 from each run's start, as the
+    report's next step asks of a user whose truth clock drifts."""
+    out = []
+    for pr in prs:
+        tr = pr.run.truth
+        if tr is not None:
+            t = tr.t_s - ppm * 1e-6 * (tr.t_s - tr.t_s[0])
+            pr = replace(pr, run=replace(pr.run, truth=replace(tr, t_s=t)))
+        out.append(pr)
+    return out
 
 
 def clock_rate(prs: list[Prepared], inst: Instrument, P: dict | None = None) -> ClockRate | None:

@@ -577,6 +577,17 @@ def markdown(rep: dict) -> str:
                 f"ppm within a run ({cr['runs']} of {cr['of']} runs: latency on their first and "
                 "last thirds)"
             )
+            if cr.get("restamped_ratio_after") is not None:
+                L.append(
+                    f"  - re-stamped by that rate, the truth leaves the named candidate at "
+                    f"{cr['restamped_ratio_after']:.2f} x the background on the held-out runs "
+                    f"(against {hd['ratio_after']:.2f} x as stamped): "
+                    + (
+                        "the clock's misfit"
+                        if v["effect"] == "unexplained"
+                        else "not the clock's, and the verdict stands"
+                    )
+                )
         L += [f"- {n}" for n in inst["notes"]]
     L += ["", "## Not identifiable from these data", ""]
     L += [f"- {u['what']}: {u['why']}" for u in rep["unidentifiable"]]
