@@ -321,7 +321,6 @@ def _lever_with_skid(ds: Dataset, keys: list[str], best: _Levers, nom: _Levers) 
     # fitted left 31 x the background held out, 3.3 x with the marker and latency read here.
     # Asked beside the cornering readings on every robot with a gap, it took a clapper's
     # cornering skid at 10 ms ticks from 8 s to 18 s (4071 case 10)
-    print("LEFT", left)
     if left >= R_GAP * R_GAP:
         r, dev, chi, n = reading(each(FRICTION_LIMIT))
         if (c := qbic(r, dev, n)) < cost:
