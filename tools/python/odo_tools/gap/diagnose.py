@@ -349,9 +349,9 @@ def _lever_rounds(ds: Dataset, keys: list[str], nominal_first: bool = False) -> 
     # one Eb for both left an Eb on truck A 1.7-1.9 mm in both markers sideways, the link's
     # direction turned, and a rotary bias joined the Eb (dev 2601 case 5)
     own_eb = _per_truck(keys, "eb.value") if ds.robot.n_trucks > 1 else keys
+    starts = grip_starts(keys, ds.prs)
     for rnd in range(2):
         prob = Problem("truth", items)
-        starts = grip_starts(keys, ds.prs)
         P = (
             {}
             if nominal_first and rnd == 0
