@@ -205,3 +205,35 @@ def test_a_sets_marker_and_latency_are_read_beside_a_friction_skid(tmp_path: Pat
     assert rep["verdict"]["params"]["skid@friction.a_lim_m_s2"] == pytest.approx(true, rel=0.05)
     h = rep["heldout"]
     assert h["ratio_after"] ** 2 - 1 < 0.05 * (h["ratio_before"] ** 2 - 1), h
+
+
+@pytest.mark.parametrize(
+    ("seed", "k", "vehicle", "laws", "asked"),
+    [
+        (4071, 43, "set", {"skid": "friction"}, True),
+        (4071, 10, "clapper", {"skid": "cornering"}, False),
+    ],
+)
+def test_the_friction_reading_is_asked_where_the_cornering_readings_leave_a_gap(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, seed, k, vehicle, laws, asked
+) -> None:
+    """The markers are read under a friction circle's skid only where the best cornering reading
+    still leaves the tracks overdispersed by R_GAP^2 (diagnose._lever_with_skid): on dev 4071/43
+    (a friction skid) it is asked, on a clapper's cornering skid at 10 ms ticks (4071/10), which
+    the cornering law reads to within the noise, it is not (asked there, it doubled the time)."""
+    from odo_tools.gap import diagnose as D
+    from odo_tools.gap.fit import FRICTION_LIMIT
+
+    real = tmp_path / "real"
+    indep_case(seed, k, real, vehicle, laws)
+    readings = []
+    rounds = D._lever_rounds
+
+    def spy(ds, keys, nominal_first=False):
+        readings.append(list(keys))
+        return rounds(ds, keys, nominal_first)
+
+    monkeypatch.setattr(D, "_lever_rounds", spy)
+    D.load(real, real / "robot.json", "truth")
+    assert any(k.startswith("skid@cornering") for ks in readings for k in ks), readings
+    assert any(k.startswith(FRICTION_LIMIT) for ks in readings for k in ks) == asked, readings
