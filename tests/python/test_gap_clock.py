@@ -2,7 +2,9 @@
 run's latency grows linearly from its start to its end, which one latency per run cannot
 follow. The runs' latencies on their first and last thirds give the rate (instrument.clock_rate,
 under the best candidate); runs that agree on it beyond instrument.CLOCK_RATE_Z standard errors
-make the verdict "unexplained", with the rate in the reason and the report."""
+make the verdict "unexplained", with the rate in the reason and the report - over a candidate
+the verdict's rule names only where the truth re-stamped by the rate confirms it
+(diagnose._clock_confirmed)."""
 
 from __future__ import annotations
 
