@@ -308,9 +308,8 @@ def _lever_with_skid(ds: Dataset, keys: list[str], best: _Levers, nom: _Levers) 
     cost, left = qbic(best, dev, n), c_hat
     if (c := qbic(nom, dev_nom, n_nom)) < cost:
         best, cost = nom, c
-    subsets = [
-        [k for i, k in enumerate(each(kc)) if m >> i & 1] for m in range(1, 1 << len(each(kc)))
-    ]
+    corner = each(kc)
+    subsets = [[k for i, k in enumerate(corner) if m >> i & 1] for m in range(1, 1 << len(corner))]
     for r, dev, chi, n in par.each([functools.partial(reading, sk) for sk in subsets]):
         if (c := qbic(r, dev, n)) < cost:
             best, cost, left = r, c, chi / n
