@@ -352,3 +352,34 @@ def test_geometry_the_tracks_want_joins_a_best_that_has_none(tmp_path: Path) -> 
     assert h["ratio_after"] < 0.25 * h["ratio_before"], h  # count loss alone: 88.9 -> 38.6 x
     said = rep["proposals"]["the accumulated track"]
     assert "count_loss@plateau[A]+ed[A] fitted to the tracks" in said, said
+
+
+def test_of_members_the_tracks_can_spare_the_windows_keep_the_strongest() -> None:
+    """Independent world, seed 3191 case 21 (traced after its blind): the windows' best was
+    "scrub + slip" on a LabMate whose tyres slip under acceleration. Either member could leave
+    the fitting runs' tracks (scrub alone 1.69, slip alone 1.76 x the background, the pair 1.68);
+    the one whose removal left the tracks lowest went, the slip, though the windows put the
+    slip alone 322 ahead of the scrub in BIC, and the scrub at its bound bent the held-out
+    circle to 431 mm. The windows now keep the member they value most; a member the tracks
+    need still stays."""
+    from odo_tools.gap import hypotheses
+    from odo_tools.gap.fit import Fit
+
+    hs = {h.name: h for h in hypotheses.singles("truth", "labmate")}
+
+    def fit(h: hypotheses.Hypothesis, dev: float) -> Fit:
+        return Fit(h.name, {}, {}, dev, dev, 5000, len(h.params), hyp=h)
+
+    pair = fit(hs["scrub"] + hs["slip"], 1580.0)
+    alone = {"scrub": (1.686, fit(hs["scrub"], 1965.0)), "slip": (1.764, fit(hs["slip"], 1635.0))}
+
+    def refit(h: hypotheses.Hypothesis, cur: Fit) -> tuple[float, Fit]:
+        return alone[h.name]
+
+    got, r = D._drop_members(pair, 1.68, refit)
+    assert (got.name, r) == ("slip", 1.764)
+    alone["slip"] = (2.6, alone["slip"][1])  # without the scrub the tracks' excess triples
+    got, r = D._drop_members(pair, 1.68, refit)
+    assert (got.name, r) == ("scrub", 1.686)
+    alone["scrub"] = (2.6, alone["scrub"][1])  # both needed: the pair stays
+    assert D._drop_members(pair, 1.68, refit)[0] is pair
