@@ -383,3 +383,24 @@ def test_of_members_the_tracks_can_spare_the_windows_keep_the_strongest() -> Non
     assert (got.name, r) == ("scrub", 1.686)
     alone["scrub"] = (2.6, alone["scrub"][1])  # both needed: the pair stays
     assert D._drop_members(pair, 1.68, refit)[0] is pair
+
+
+def test_a_spare_member_whose_removal_mends_the_tracks_leaves_whatever_the_windows_say() -> None:
+    """Independent world, dev seed 4071 case 19, a LabMate with no effect: the windows' best
+    was "skid + slip" at 8.2 x the background on the fitting tracks; the skid alone leaves
+    1.34 x, the catalog's slip alone 7.6 x, though the windows put the slip 378 ahead. Both
+    are spare, but not alike to the tracks (the slip's excess is 70 times the skid's): the
+    slip leaves. By the windows alone it stayed, and the truth's clock, scanned at 15 ms
+    (the world's 14 ms), went to 8-15 ms run by run."""
+    from odo_tools.gap import hypotheses
+    from odo_tools.gap.fit import Fit
+
+    hs = {h.name: h for h in hypotheses.singles("truth", "labmate")}
+
+    def fit(h: hypotheses.Hypothesis, dev: float) -> Fit:
+        return Fit(h.name, {}, {}, dev, dev, 5000, len(h.params), hyp=h)
+
+    alone = {"skid": (1.34, fit(hs["skid"], 6350.0)), "slip": (7.6, fit(hs["slip"], 5970.0))}
+    pair = fit(hs["skid"] + hs["slip"], 5870.0)
+    got, r = D._drop_members(pair, 8.2, lambda h, cur: alone[h.name])
+    assert (got.name, r) == ("skid", 1.34)
