@@ -171,29 +171,3 @@ def test_split_judges_every_kind_of_motion() -> None:
     keys2 = [*keys[:6], "cw:2", "cw:2", "ccw:2"]
     sel = stratified(keys2, 0.5, 1, [*kinds[:6], "arc", "arc", "arc"])
     assert 8 not in sel.held and len({6, 7} & set(sel.held)) == 1
-
-
-def test_heading_corrections_do_not_make_a_straight_run_an_arc() -> None:
-    """A shuttle (1 m out and back) whose heading corrections add up to 0.34 rad was an "arc"
-    run, and with it held out the split counted the arcs judged: every figure eight of a
-    LabMate with a turn-radius-dependent wheelbase was fitted, and its scrub (Delta BIC 215)
-    was judged on runs it does not touch, "no significant gap" (independent world, seed 3201
-    case 5, traced after its blind). A run turning less than a quarter turn in all drives
-    straight; a figure eight (two full turns) is arcs, squares' spot turns are spot turns."""
-    from types import SimpleNamespace
-
-    import numpy as np
-    from odo_tools.gap.paths import motion_kind
-
-    def run(left: np.ndarray, right: np.ndarray) -> SimpleNamespace:
-        return SimpleNamespace(ds=np.stack([left, right], axis=1)[:, None, :], b=[400.0])
-
-    n = 200
-    out_back = np.r_[np.full(n // 2, 10.0), np.full(n // 2, -10.0)]
-    wiggle = 0.34 * np.where(np.arange(n) % 2 == 0, 1.0, -1.0)  # 0.68 mm apart every tick
-    assert motion_kind(run(out_back - wiggle, out_back + wiggle)) == "straight"
-    eight = np.full(n, 100.0)
-    turn = 4 * np.pi * 400.0 / n / 2 * np.where(np.arange(n) < n // 2, 1.0, -1.0)
-    assert motion_kind(run(eight - turn, eight + turn)) == "arc"
-    spin = np.full(n, 5.0)
-    assert motion_kind(run(-spin, spin)) == "spot"

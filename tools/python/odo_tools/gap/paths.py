@@ -58,13 +58,6 @@ def assign_paths(prs: list[Prepared]) -> None:
 SHAPE_TRAVEL_TOL = 0.05
 SHAPE_HEADING_TOL_RAD = 0.35
 SPOT_SHARE = 0.5  # share of the turning done on the spot that makes a shape "spot turns"
-# a run that turns less than a quarter turn in all (on the spot and on arcs) drives straight:
-# the heading corrections of a shuttle (0.34 rad over 2.1 m, a "mean radius" of 8.5 m) made it
-# the held-out "arc" run of a LabMate whose every real arc (two figure eights) was fitted, and
-# the inverse-radius scrub they show (Delta BIC 215, 9 standard errors between spot turns and
-# arcs) was judged on runs it does not touch: "no significant gap" (independent world, seed
-# 3201 case 5, traced after its blind)
-STRAIGHT_RAD = math.pi / 2
 
 
 def _turning(pr: Prepared) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -85,7 +78,7 @@ def motion_kind(pr: Prepared) -> str:
     """How a run turns, in one word: 'spot' (most of its turning on the spot), 'arc' or
     'straight' (barely turns). The held-out split covers every kind the fit sees (select.py)."""
     spot, arc = turn_style(pr)
-    if spot + arc < STRAIGHT_RAD:
+    if spot + arc < 0.3:
         return "straight"
     return "spot" if spot >= SPOT_SHARE * (spot + arc) else "arc"
 
@@ -94,7 +87,7 @@ def describe_shape(pr: Prepared) -> str:
     """A short name for a run's path: its length and how it turns ('3.0 m, spot turns')."""
     spot, arc = turn_style(pr)
     L = float(pr.S[-1, 0].mean()) / 1000.0
-    if spot + arc < STRAIGHT_RAD:
+    if spot + arc < 0.3:
         how = "straight"
     elif spot >= SPOT_SHARE * (spot + arc):
         how = "spot turns"
