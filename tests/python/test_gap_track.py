@@ -354,6 +354,19 @@ def test_geometry_the_tracks_want_joins_a_best_that_has_none(tmp_path: Path) -> 
     assert "count_loss@plateau[A]+ed[A] fitted to the tracks" in said, said
 
 
+def _fit(*names: str, dev: float):
+    """A LabMate's truth-mode Fit of the catalog singles `names` joined, with deviance `dev`
+    (the windows' BIC, for _drop_members), on 5000 values."""
+    from odo_tools.gap import hypotheses
+    from odo_tools.gap.fit import Fit
+
+    hs = {h.name: h for h in hypotheses.singles("truth", "labmate")}
+    h = hs[names[0]]
+    for n in names[1:]:
+        h = h + hs[n]
+    return Fit(h.name, {}, {}, dev, dev, 5000, len(h.params), hyp=h)
+
+
 def test_of_members_the_tracks_can_spare_the_windows_keep_the_strongest() -> None:
     """Independent world, seed 3191 case 21 (traced after its blind): the windows' best was
     "scrub + slip" on a LabMate whose tyres slip under acceleration. Either member could leave
@@ -362,18 +375,10 @@ def test_of_members_the_tracks_can_spare_the_windows_keep_the_strongest() -> Non
     slip alone 322 ahead of the scrub in BIC, and the scrub at its bound bent the held-out
     circle to 431 mm. The windows now keep the member they value most; a member the tracks
     need still stays."""
-    from odo_tools.gap import hypotheses
-    from odo_tools.gap.fit import Fit
+    pair = _fit("scrub", "slip", dev=1580.0)
+    alone = {"scrub": (1.686, _fit("scrub", dev=1965.0)), "slip": (1.764, _fit("slip", dev=1635.0))}
 
-    hs = {h.name: h for h in hypotheses.singles("truth", "labmate")}
-
-    def fit(h: hypotheses.Hypothesis, dev: float) -> Fit:
-        return Fit(h.name, {}, {}, dev, dev, 5000, len(h.params), hyp=h)
-
-    pair = fit(hs["scrub"] + hs["slip"], 1580.0)
-    alone = {"scrub": (1.686, fit(hs["scrub"], 1965.0)), "slip": (1.764, fit(hs["slip"], 1635.0))}
-
-    def refit(h: hypotheses.Hypothesis, cur: Fit) -> tuple[float, Fit]:
+    def refit(h, cur):
         return alone[h.name]
 
     got, r = D._drop_members(pair, 1.68, refit)
@@ -392,15 +397,7 @@ def test_a_spare_member_whose_removal_mends_the_tracks_leaves_whatever_the_windo
     are spare, but not alike to the tracks (the slip's excess is 70 times the skid's): the
     slip leaves. By the windows alone it stayed, and the truth's clock, scanned at 15 ms
     (the world's 14 ms), went to 8-15 ms run by run."""
-    from odo_tools.gap import hypotheses
-    from odo_tools.gap.fit import Fit
-
-    hs = {h.name: h for h in hypotheses.singles("truth", "labmate")}
-
-    def fit(h: hypotheses.Hypothesis, dev: float) -> Fit:
-        return Fit(h.name, {}, {}, dev, dev, 5000, len(h.params), hyp=h)
-
-    alone = {"skid": (1.34, fit(hs["skid"], 6350.0)), "slip": (7.6, fit(hs["slip"], 5970.0))}
-    pair = fit(hs["skid"] + hs["slip"], 5870.0)
+    alone = {"skid": (1.34, _fit("skid", dev=6350.0)), "slip": (7.6, _fit("slip", dev=5970.0))}
+    pair = _fit("skid", "slip", dev=5870.0)
     got, r = D._drop_members(pair, 8.2, lambda h, cur: alone[h.name])
     assert (got.name, r) == ("skid", 1.34)
