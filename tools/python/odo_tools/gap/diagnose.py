@@ -1401,6 +1401,8 @@ def judge(ds: Dataset, sel: Selection, rk: Ranking) -> Judgement:
     hprs = [ds.prs[i] for i in sel.held if i not in sel.fit]
     held_items = [items[i] for i in sel.held if i not in sel.fit]
     apply(rk.best, hprs, HELDOUT_BUMP_MIN_RUNS, tracked(held_items))  # as evaluate_heldout
+    for pr in hprs:  # the background as before: no bump on one fitting run's word
+        pr.bumps = [b for b in pr.bumps if not b.get("tentative")]
     apply(rk.best, fprs)
     pool = [items[i] for i in sel.held if i not in sel.fit] if ds.mode == "truth" else None
     bg = measure(fit_items, rk.prob.sigma, ds.mode, rk.best.model_params(), pool=pool)
