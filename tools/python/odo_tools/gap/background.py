@@ -101,7 +101,7 @@ class Background:
         # 76 mm wheels, heading walk 0, lost 1-1.5 mm along a 15 m run; with only the truth's
         # 0.3 mm noise allowed, its no-effect set sat at 2.2 x the background
         if qm <= 0 and qt <= 0 and ql <= 0:
-            return np.zeros((item.tt[item.i].size, 3))
+            return self.count_var(item, truck)
         # keyed by what it reads: the walk, and the floor bumps placed on the run (the nominal
         # track below is dead-reckoned over them); the item is kept with it, so that another
         # item that comes to have the same id() is not served this one's
@@ -113,10 +113,22 @@ class Background:
             ql,
             tuple((b["truck"], b["wheel"], b["s0"], b["h"]) for b in item.pr.bumps),
         )
+        return self._cached(
+            key,
+            item,
+            lambda: self._track_var(item, truck, qm, qt, ql) + self.count_var(item, truck),
+        )
+
+    def count_var(self, item: TruthMode, truck: int) -> np.ndarray:
+        """(nwin, 3) variance of the accumulated x, y, heading error that the counts' own
+        resolution leaves at each window start of a run (`counting_error`), cached per run."""
+        return self._cached(("counts", id(item), truck), item, lambda: counting_error(item, truck))
+
+    def _cached(self, key: tuple, item: TruthMode, make) -> np.ndarray:
         hit = self._tv.get(key)
         if hit is not None and hit[0] is item:
             return hit[1]
-        out = self._track_var(item, truck, qm, qt, ql)
+        out = make()
         out.setflags(write=False)  # shared by every caller
         if len(self._tv) >= TRACK_VAR_CACHE:  # bump fits place a new set of bumps at every step
             self._tv.clear()
@@ -175,6 +187,74 @@ class Background:
             out[:, 0] += cs(el * c * c)[k_end]
             out[:, 1] += cs(el * s_ * s_)[k_end]
         return np.maximum(out, 0.0)
+
+
+COUNT_DRAWS = 64  # encoder phases drawn by counting_error
+COUNT_SMOOTH = 5  # ticks the counts are averaged over to stand for the travel between counts
+
+
+def counting_error(item: TruthMode, truck: int, draws: int = COUNT_DRAWS) -> np.ndarray:
+    """(nwin, 3) variance of the accumulated x, y (mm^2) and heading (rad^2) error that counting
+    alone leaves along a run, anchored as TruthMode.anchored anchors it. A counter reads the
+    floor of its wheel's travel in counts, so the heading the model takes from two counters is
+    off by the difference of the two wheels' unread fractions (up to one count over the
+    wheelbase), and that error does not average out: while both wheels turn alike (a straight)
+    the fractions keep their difference, a heading error held over the whole straight that
+    carries the track sideways in proportion to the distance. The fractions are unknown; their
+    spread is drawn: the wheels' travel (the counts, averaged over COUNT_SMOOTH ticks so that
+    it moves between whole counts) under a uniform encoder phase per wheel and draw,
+    dead-reckoned along the counts' own track. The independent world's encoders give one
+    count from 0.003 to 11 mrad of heading (dev seeds 4061-4111, median 0.16). Seven LabMates
+    of dev seeds 4061-4091 with 0.9-7.8 mrad a count, quieted (no effect, perfect floor and
+    sensors: cases.quiet), left the nominal model 0.05-8.5 mm RMS along their runs (0.7-2.7 x
+    what is drawn here, robot by robot), and five were "unexplained" at 1.5-24 x the
+    background without this term; with it, one (4081 case 23, at 1.8 x: the robot drives from
+    its own counts, and how that loop dithers the wheels about a count is not drawn here)."""
+    pr = item.pr
+    tw = item.tt[item.i]
+    if not pr.count_mm or truck >= len(pr.count_mm) or pr.count_mm[truck] <= 0:
+        return np.zeros((tw.size, 3))
+    from .modes import ANCHOR_S
+
+    c = pr.count_mm[truck]
+    b = pr.b[truck]
+    X = np.vstack([np.zeros((1, 2)), np.cumsum(pr.ds[:, truck, :], axis=0)]) / c
+    k = np.ones(COUNT_SMOOTH) / COUNT_SMOOTH
+    h = COUNT_SMOOTH // 2
+    X = np.column_stack(
+        [np.convolve(np.pad(X[:, w], h, mode="edge"), k, mode="valid") for w in (0, 1)]
+    )
+    rng = np.random.default_rng(1)
+    ph = rng.uniform(0.0, 1.0, (draws, 1, 2))
+    eps = np.mod(X[None] + ph, 1.0)  # each wheel's unread fraction at each tick
+    eps = eps - eps[:, :1]  # counted from the run's first tick
+    dth = -(eps[..., 1] - eps[..., 0]) * c / b  # (draws, n) heading error (right - left)
+    dl = -0.5 * (eps[..., 0] + eps[..., 1]) * c  # travel error along the track
+    # the counts' own track (no bump or effect: only where the errors are carried matters)
+    d = 0.5 * (pr.ds[:, truck, 0] + pr.ds[:, truck, 1])  # signed: a shuttle reverses
+    th = np.concatenate([[0.0], np.cumsum((pr.ds[:, truck, 1] - pr.ds[:, truck, 0]) / b)])
+    hm = 0.5 * (th[:-1] + th[1:])
+    px = np.concatenate([[0.0], np.cumsum(d * np.cos(hm))])
+    py = np.concatenate([[0.0], np.cumsum(d * np.sin(hm))])
+    mid = 0.5 * (dth[:, :-1] + dth[:, 1:])
+    z = np.zeros((draws, 1))
+    ex = np.concatenate([z, np.cumsum(-d * np.sin(hm) * mid, axis=1)], axis=1)
+    ey = np.concatenate([z, np.cumsum(d * np.cos(hm) * mid, axis=1)], axis=1)
+    ex += dl * np.cos(th)
+    ey += dl * np.sin(th)
+    a = pr.t <= pr.t[0] + ANCHOR_S  # the anchor takes the mean offsets over its first seconds
+    d0 = dth[:, a].mean(axis=1)[:, None]
+    ex += d0 * py  # the anchor turns the whole track about its start
+    ey -= d0 * px
+    dth = dth - d0
+    ex -= ex[:, a].mean(axis=1)[:, None]
+    ey -= ey[:, a].mean(axis=1)[:, None]
+    # into the truth's frame: the counts' track starts at heading 0, the truth where it stands
+    h0 = item.tpose[item.tt <= item.tt[0] + ANCHOR_S, truck, 2]
+    h0 = math.atan2(float(np.mean(np.sin(h0))), float(np.mean(np.cos(h0))))
+    ex, ey = math.cos(h0) * ex - math.sin(h0) * ey, math.sin(h0) * ex + math.cos(h0) * ey
+    kk = np.clip(np.searchsorted(pr.t, tw, side="right") - 1, 0, pr.t.size - 1)
+    return np.column_stack([ex[:, kk].var(axis=0), ey[:, kk].var(axis=0), dth[:, kk].var(axis=0)])
 
 
 BLOCKS = (1, 2, 4, 8)  # block lengths in windows (0.4 - 3.2 s) of the multi-scale estimate

@@ -215,6 +215,10 @@ class Report:
             ]
         if bg.spread is not None:
             bgd["return_spread"] = dict(zip(chans, map(float, bg.spread), strict=False))
+        if ds.mode == "truth":
+            bgd["count_heading_mrad"] = [
+                1e3 * c / b for c, b in zip(ds.prs[0].count_mm, ds.prs[0].b, strict=False)
+            ]
         bgd["heldout_allowance_mm"] = held.bg_mm
         bgd["heldout_allowance_deg"] = held.bg_deg
         named = jd.verdict not in SPECIAL
@@ -620,6 +624,11 @@ def _remainder(rep: dict) -> str:
             "sigma) per 90 deg turn on the spot, different on every run (floor and wheels, "
             "measured under the candidate), and the truth's own noise"
         )
+        if "count_heading_mrad" in bg:
+            parts.append(
+                f"and the counts' own resolution (one count is {bg['count_heading_mrad'][0]:.2g}"
+                " mrad of heading, an error held along each straight: background.counting_error)"
+            )
     if "return_spread" in bg:
         s = bg["return_spread"]
         parts.append(
