@@ -32,7 +32,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .model import track_at
-from .modes import TruthMode
+from .modes import ANCHOR_S, TruthMode
 
 TRACK_VAR_CACHE = 256  # runs x trucks x sets of floor bumps kept (each a few kB)
 
@@ -214,11 +214,10 @@ def counting_error(item: TruthMode, truck: int, draws: int = COUNT_DRAWS) -> np.
     tw = item.tt[item.i]
     if not pr.count_mm or truck >= len(pr.count_mm) or pr.count_mm[truck] <= 0:
         return np.zeros((tw.size, 3))
-    from .modes import ANCHOR_S
-
     c = pr.count_mm[truck]
     b = pr.b[truck]
-    X = np.vstack([np.zeros((1, 2)), np.cumsum(pr.ds[:, truck, :], axis=0)]) / c
+    ds = pr.ds[:, truck, :]
+    X = np.vstack([np.zeros((1, 2)), np.cumsum(ds, axis=0)]) / c
     k = np.ones(COUNT_SMOOTH) / COUNT_SMOOTH
     h = COUNT_SMOOTH // 2
     X = np.column_stack(
@@ -230,9 +229,10 @@ def counting_error(item: TruthMode, truck: int, draws: int = COUNT_DRAWS) -> np.
     eps = eps - eps[:, :1]  # counted from the run's first tick
     dth = -(eps[..., 1] - eps[..., 0]) * c / b  # (draws, n) heading error (right - left)
     dl = -0.5 * (eps[..., 0] + eps[..., 1]) * c  # travel error along the track
-    # the counts' own track (no bump or effect: only where the errors are carried matters)
-    d = 0.5 * (pr.ds[:, truck, 0] + pr.ds[:, truck, 1])  # signed: a shuttle reverses
-    th = np.concatenate([[0.0], np.cumsum((pr.ds[:, truck, 1] - pr.ds[:, truck, 0]) / b)])
+    # the counts' own track (no bump or effect: only where the errors are carried matters),
+    # midpoint steps as the errors below are carried
+    d = 0.5 * (ds[:, 0] + ds[:, 1])  # signed: a shuttle reverses
+    th = np.concatenate([[0.0], np.cumsum((ds[:, 1] - ds[:, 0]) / b)])
     hm = 0.5 * (th[:-1] + th[1:])
     px = np.concatenate([[0.0], np.cumsum(d * np.cos(hm))])
     py = np.concatenate([[0.0], np.cumsum(d * np.sin(hm))])
@@ -250,7 +250,9 @@ def counting_error(item: TruthMode, truck: int, draws: int = COUNT_DRAWS) -> np.
     ex -= ex[:, a].mean(axis=1)[:, None]
     ey -= ey[:, a].mean(axis=1)[:, None]
     # into the truth's frame: the counts' track starts at heading 0, the truth where it stands
-    h0 = item.tpose[item.tt <= item.tt[0] + ANCHOR_S, truck, 2]
+    # (the anchor's heading offset, as TruthMode.anchored takes it, not the heading driven to)
+    ka = item.tt <= item.tt[0] + ANCHOR_S
+    h0 = item.tpose[ka, truck, 2] - np.interp(item.tt[ka], pr.t, th)
     h0 = math.atan2(float(np.mean(np.sin(h0))), float(np.mean(np.cos(h0))))
     ex, ey = math.cos(h0) * ex - math.sin(h0) * ey, math.sin(h0) * ex + math.cos(h0) * ey
     kk = np.clip(np.searchsorted(pr.t, tw, side="right") - 1, 0, pr.t.size - 1)
