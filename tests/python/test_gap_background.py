@@ -591,17 +591,19 @@ def test_a_sets_weak_gap_is_not_judged_by_its_fitting_tracks(tmp_path: Path) -> 
     assert v["effect"] == "no significant gap", v["reason"]
 
 
-def _quiet_labmate(real: Path) -> dict:
-    """The independent world's dev seed 4071 case 59 (a LabMate with no effect and 5-line
-    encoders: one count is 0.89 mrad of heading), quieted: a perfect floor, perfect sensors."""
+def _quiet_labmate(real: Path, seed: int = 4071, case: int = 59) -> dict:
+    """A LabMate of the independent world with its effects removed, quieted: a perfect floor,
+    perfect sensors. Dev seed 4071 case 59 has no effect and 5-line encoders (one count is 0.89
+    mrad of heading); 4061/37 (7 lines, 5.4 mm a count) drew a pair of effects, taken away."""
     from odo_tools.validation import case_seed, indep
     from odo_tools.validation.indep import cases
 
-    rng = np.random.default_rng(4071)
-    c = [indep.draw_case(rng, i) for i in range(60)][59]
-    assert (c["vehicle"], c["kind"]) == ("labmate", "none"), "the world moved: pick another"
+    rng = np.random.default_rng(seed)
+    c = [indep.draw_case(rng, i) for i in range(case + 1)][case]
+    assert c["vehicle"] == "labmate", "the world moved: pick another"
     c = cases.quiet(c)
-    indep.simulate_case(c, real, case_seed(4071, 59))
+    c["true"]["effects"] = {}
+    indep.simulate_case(c, real, case_seed(seed, case))
     return c
 
 
@@ -619,6 +621,28 @@ def test_counting_alone_is_no_gap_on_a_perfect_robot_with_coarse_encoders(tmp_pa
     assert rep["verdict"]["effect"] == "no significant gap", rep["verdict"]["reason"]
     assert rep["heldout"]["ratio_before"] < 1.5, rep["heldout"]["ratio_before"]
     assert rep["background"]["heldout_allowance_mm"] > 2 * rep["gap_before_mm"] / 3
+
+
+def test_a_window_carries_its_counts_unread_fractions(tmp_path: Path) -> None:
+    """On a perfect LabMate with coarse counts (4061/37 quieted: 5.4 mm a count) what a fitting
+    window's body increment misses is counting alone, and TruthMode.own_var says how much: the
+    moving windows' mean square residual per channel is within 0.5-2.5 x of it (the robot's own
+    loop dithers its wheels about a count, which the draw does not know). Without it the fit
+    took the truth's robust noise (0.02 mm) as the windows' spread, and slip, which moves
+    exactly the windows where the fractions change, won by Delta BIC 87,000 on this robot."""
+    from odo_tools.gap import diagnose as D
+
+    real = tmp_path / "real"
+    _quiet_labmate(real, 4061, 37)
+    ds = D.load(real, real / "robot.json", "truth")
+    moving = np.concatenate([~it.stationary() for it in ds.items])
+    r = np.vstack([it.residuals({}) for it in ds.items])[moving]
+    v = np.vstack([it.own_var(None) for it in ds.items])[moving]
+    ratio = np.mean(r * r, axis=0) / np.mean(v, axis=0)
+    assert np.all((ratio > 0.5) & (ratio < 2.5)), ratio
+    rep = D.diagnose(real, real / "robot.json", mode="truth").to_dict()
+    assert rep["verdict"]["effect"] == "no significant gap", rep["verdict"]["reason"]
+    assert rep["verdict"]["evidence"]["dbic_vs_nominal"] < 1000
 
 
 def test_the_counting_allowance_grows_along_a_straight_and_with_the_count(tmp_path: Path) -> None:
