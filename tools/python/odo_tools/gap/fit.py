@@ -3,9 +3,9 @@
 Evidence is BIC: deviance -2 ln L of Gaussian residuals (per-channel noise sigma estimated once
 from the data: the truth's sample noise, the returns' spread or stated accuracy, the linkage
 encoders' quantisation and, per window, the wheel counters' that the prediction carries
-(modes.LinkageMode.own_var, modes.TruthMode.own_var); roughness adds its own variance) plus k ln n for k fitted
-parameters over n residual scalars. Lower is better; Delta BIC > 10 is "very strong" (Kass &
-Raftery 1995) and is the threshold used throughout.
+(modes.LinkageMode.own_var, modes.TruthMode.own_var); roughness adds its own variance) plus
+k ln n for k fitted parameters over n residual scalars. Lower is better; Delta BIC > 10 is
+"very strong" (Kass & Raftery 1995) and is the threshold used throughout.
 """
 
 from __future__ import annotations
