@@ -962,7 +962,22 @@ def link_bias(P: dict, alpha: np.ndarray, beta: np.ndarray) -> tuple:
     bl = P.get("link_bias.const_mm", 0.0) + P.get("link_bias.ecc_mm", 0.0) * (
         1 - np.cos(alpha - beta)
     )
-    return ba, bb, bl
+    return ba, bb, bl + _link_ends(P, alpha, beta)
+
+
+def _link_ends(P: dict, alpha, beta):
+    """`link_bias@offset`: a linear encoder whose ends sit off the pivots, by (u, v) in a
+    truck's frame, reads the link length plus, to first order in the offsets, the offset's
+    projection on the link, u (cos angle - 1) -/+ v sin angle at each joint (zero-referenced to
+    trucks square to the link, like the constant). The fitted terms are those amplitudes per
+    joint; a second order of a few 0.1 mm over a 1.7 m link is left to the noise."""
+    out = 0.0
+    for joint, angle in (("alpha", alpha), ("beta", beta)):
+        s = P.get(f"link_bias@offset.{joint}_s_mm", 0.0)
+        c = P.get(f"link_bias@offset.{joint}_c_mm", 0.0)
+        if s != 0.0 or c != 0.0:
+            out = out + s * np.sin(angle) + c * (np.cos(angle) - 1.0)
+    return out
 
 
 def _once_per_turn(P: dict, joint: str, angle):

@@ -699,9 +699,7 @@ class LinkageMode:
 
     @staticmethod
     def _lbias(P: dict, a, b):
-        return P.get("link_bias.const_mm", 0.0) + P.get("link_bias.ecc_mm", 0.0) * (
-            1 - np.cos(a - b)
-        )
+        return link_bias(P, a, b)[2]
 
     def residuals(self, P: dict) -> np.ndarray:
         return self._profile(self._pred(P))
