@@ -98,3 +98,49 @@ def test_a_link_encoder_off_its_pivots_is_named_beside_an_ed(tmp_path: Path) -> 
     assert got["link_bias.const_mm"] == pytest.approx(want["link_bias.const_mm"], abs=0.3)
     for k in want:
         assert got[k] == pytest.approx(want[k], abs=1.0), k
+
+
+def test_a_linkage_channel_is_judged_on_its_own_where_it_shows_more_than_the_pool() -> None:
+    """Truth mode compares the linkage readings with the true linkage, so they carry only the
+    joint encoders' own errors; pooled with every truck's track they drown (3251 case 40: the
+    link channel at 5.3 x its noise in z^2, the pool at 1.01 x). heldout.evaluate judges such a
+    channel on its own before, and after on whichever of it and the pool shows more: a
+    candidate that mends the channel alone leaves the tracks' misfit standing."""
+    from odo_tools.gap.heldout import RunGap, _judged, _judged_channel, _ratio
+
+    def run(track: float, link: tuple) -> RunGap:
+        # 100 windows: 600 track values and 3 linkage channels of 100 each
+        z2 = track * 600 + sum(link) * 100
+        return RunGap("r", 0.0, 0.0, z2, 900, link_z2=tuple(x * 100 for x in link), link_n=100)
+
+    quiet = [run(0.5, (0.4, 0.4, 0.45))] * 2
+    assert _judged_channel(quiet) is None
+    biased = [run(0.5, (0.6, 0.6, 5.3))] * 2
+    assert _judged_channel(biased) == 2
+    assert _judged_channel([RunGap("r", 0.0, 0.0, 900.0, 900)]) is None  # no linkage
+    # the pool over the same runs: (0.5 * 600 + 6.5 * 100) / 900 = 1.06
+    assert sum(g.z2 for g in biased) / sum(g.n for g in biased) < 1.1
+    before, after, c = _judged(biased, [run(0.5, (0.6, 0.6, 0.6))] * 2)
+    assert c == 2 and _ratio(*before) == pytest.approx(5.3**0.5)
+    assert _ratio(*after) == pytest.approx((1.8 / 3) ** 0.5)  # the mended channel
+    # mended the channel, but the tracks kept their misfit: the pool judges after
+    _, after, _ = _judged(biased, [run(3.0, (0.6, 0.6, 0.6))] * 2)
+    assert _ratio(*after) == pytest.approx(((3.0 * 600 + 180) / 900) ** 0.5)
+    before, after, c = _judged(quiet, quiet)
+    assert c is None and _ratio(*before) == pytest.approx(((300 + 125) / 900) ** 0.5)
+
+
+def test_a_link_encoder_drowned_by_the_tracks_is_named(tmp_path: Path) -> None:
+    """Independent world, dev seed 4061 case 43: a clapper whose link-length encoder reads
+    1.83 mm plus its ends' offsets. Pooled with the tracks its held-out runs sat at 1.19 x the
+    background, "no significant gap"; judged on the link channel they are a gap the ends' law
+    closes."""
+    from odo_tools.gap.diagnose import diagnose
+
+    real = tmp_path / "real"
+    indep_case(4061, 43, real, "clapper", {"link_bias": "eccentric"})
+    rep = diagnose(real, real / "robot.json", mode="truth").to_dict()
+    v = rep["verdict"]
+    assert v["effect"] == "link_bias", v["reason"]
+    assert rep["heldout"]["ratio_before"] >= 2.0 and rep["heldout"]["ratio_after"] <= 1.0
+    assert rep["heldout"]["judged_on"] == "l_mm"

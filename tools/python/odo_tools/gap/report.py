@@ -58,10 +58,18 @@ LAW_WORDS = {
     "beyond it (fast turns) the centre falls behind the wheels' path while the heading follows",
     "eccentric": "a joint encoder's offset that varies once per turn of its shaft (a disc "
     "mounted off centre): b0 + s sin(angle) + c (cos(angle) - 1)",
+    "offset": "a link-length encoder whose ends sit off the pivots: b0 + s sin(angle) + "
+    "c (cos(angle) - 1) at each joint, the offsets' projection on the link",
 }
 # effects a parameter block corrects (odo-calib): what a next step can fix on the robot
 KINEMATIC = ("ed", "eb", "es", "scrub")
 SPECIAL = ("no significant gap", "unexplained")
+
+
+def _judged_on(hd: dict) -> str:
+    """Where one linkage channel was judged on its own (heldout._judged_channel): which."""
+    on = hd.get("judged_on", "every channel")
+    return "" if on == "every channel" else f" (`{on}` on its own before)"
 
 
 def words(label: str) -> str:
@@ -95,6 +103,8 @@ def unit(key: str) -> str:
         }.get(p, "")
         if p.endswith("_deg"):  # the once-per-turn terms of a joint encoder's offset
             u = "deg"
+        elif p.endswith("_mm"):  # a link encoder's ends off the pivots
+            u = "mm"
     return "" if u in ("1", "-") else u
 
 
@@ -268,6 +278,8 @@ class Report:
             "deg_after": held.deg_after,
             "ratio_before": held.ratio_before,
             "ratio_after": held.ratio_after,
+            # a linkage channel judged on its own (heldout._judged_channel), or the pool
+            "judged_on": held.extra.get("judged_on", "every channel"),
             "gap_before": held.gap_before,
             "gap_after": held.gap_after,
             "shrink": held.shrink,
@@ -492,8 +504,8 @@ def markdown(rep: dict) -> str:
             if rep["mode"] == "truth"
             else []
         ),
-        f"| misfit in units of the background | {hd['ratio_before']:.2f} | {hd['ratio_after']:.2f}"
-        " | 1 |",
+        f"| misfit in units of the background{_judged_on(hd)} | {hd['ratio_before']:.2f} | "
+        f"{hd['ratio_after']:.2f} | 1 |",
         "",
         f"Shrink of the systematic gap (above the background): x{hd['shrink']:.1f} (95 % CI "
         f"{hd['shrink_ci'][0]:.1f} - {hd['shrink_ci'][1]:.1f}); of the error in mm: "
