@@ -558,7 +558,13 @@ def rank(ds: Dataset, sel: Selection, progress: Progress = None) -> Ranking:
     # tracks (truth mode): most robots have one effect, and ten pair fits cost more than the rest
     partners = [f for f in singles if not hypotheses.unproposed(f.hyp, proposals)]
     if gap and not (ds.mode == "truth" and _track_ratio(best, prob, ds, sel) <= R_WITHIN):
-        cands += _pairs(partners, prob, fprs, sig_head, progress, ds.robot.vehicle, detected)
+        pairs = _pairs(partners, prob, fprs, sig_head, progress, ds.robot.vehicle, detected)
+        polished = _polish(singles[: N_PAIR_BASE + 2], pairs, prob, fprs, sig_head)
+        if polished:
+            singles = sorted([polished.get(f.name, f) for f in singles], key=lambda f: f.bic)
+            cands = list(singles)
+            best = singles[0]
+        cands += pairs
     cands.sort(key=lambda f: f.bic)
     c_hat = max(1.0, best.chi / max(prob.e0 - best.k, 1))
     pair = next((f for f in cands if f.hyp is not None and len(f.hyp.families) == 2), None)
@@ -1243,6 +1249,29 @@ def _shape_end(key: str, value: float) -> str | None:
     if value <= lo + 1e-6 * (hi - lo):
         return "low"
     return "high" if value >= hi - 1e-3 * (hi - lo) else None
+
+
+def _polish(singles: list[Fit], pairs: list[Fit], prob, fprs, sig_head) -> dict[str, Fit]:
+    """Singles refitted from the pairs that hold them: {name: better fit}. A pair starts from
+    its members' fits and may walk a member's parameters to a better optimum than the member's
+    own start found; the single refitted from there is then the fair base the pair is judged
+    against. A clapper's catalog slip (simulator, seed 2712 case 28, k 0.98 per m/s^2) stopped
+    at k 0.43 once each truth window carried its counting variance, and scrub + slip (k 0.91)
+    beat it by Delta BIC 62,000: named although there is no scrub."""
+    out = {}
+    for f in singles:
+        if f.hyp is None or f.hyp.has_bumps or not f.params:
+            continue
+        keys = set(f.hyp.params)
+        held = [p for p in pairs if p.bic < f.bic and set(f.hyp.laws) <= set(p.hyp.laws)]
+        if not held:
+            continue
+        src = min(held, key=lambda p: p.bic)
+        warm = {k: v for k, v in src.model_params().items() if k in keys}
+        g = fit_hypothesis(f.hyp, prob, fprs, sig_head, warm=warm)
+        if _real(g) and g.bic < f.bic:
+            out[f.name] = g
+    return out
 
 
 def _warm(fits: list[Fit], names: set[str]) -> dict:
