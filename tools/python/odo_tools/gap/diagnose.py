@@ -1251,7 +1251,9 @@ def _shape_end(key: str, value: float) -> str | None:
     return "high" if value >= hi - 1e-3 * (hi - lo) else None
 
 
-def _polish(singles: list[Fit], pairs: list[Fit], prob, fprs, sig_head) -> dict[str, Fit]:
+def _polish(
+    singles: list[Fit], pairs: list[Fit], prob: Problem, fprs: list, sig_head: float
+) -> dict[str, Fit]:
     """Singles refitted from the pairs that hold them: {name: better fit}. A pair starts from
     its members' fits and may walk a member's parameters to a better optimum than the member's
     own start found; the single refitted from there is then the fair base the pair is judged

@@ -29,6 +29,7 @@ from .fit import Fit
 from .modes import TruthMode, wrap_rad
 
 HELDOUT_BUMP_MIN_RUNS = 2
+POOLED = "every channel"  # report.json heldout.judged_on where no linkage channel stood alone
 
 
 def apply(f: Fit | None, prs: list, min_runs: int = 1, items: list | None = None) -> dict:

@@ -416,11 +416,10 @@ class TruthMode:
             c = self.pr.count_mm[t] if t < len(self.pr.count_mm) else 0.0
             if c <= 0:
                 continue
-            u = np.abs(self.wtravel[t]) / c  # (2, nwin) counts turned by each wheel
-            v = (c * c / 6.0) * np.minimum(u, 1.0)
-            vs = v.sum(axis=0)
+            travel = np.abs(self.wtravel[t])  # (2, nwin) each wheel's travel in the window
+            vs = (c * c / 6.0) * np.minimum(travel / c, 1.0).sum(axis=0)
             b = self.pr.b[t]
-            L = 0.5 * (np.abs(self.wtravel[t, 0]) + np.abs(self.wtravel[t, 1]))
+            L = 0.5 * travel.sum(axis=0)
             out[:, 3 * t] = vs / 4.0
             out[:, 3 * t + 1] = (0.5 * L) ** 2 * vs / b**2
             out[:, 3 * t + 2] = vs / b**2

@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING, Any
 from . import catalog
 from .background import heading_walk_deg_per_sqrt_m, spot_turn_deg
 from .fit import DBIC_PAIR, DBIC_SIGNIFICANT, Z_GAP
+from .heldout import POOLED
 from .stability import STABLE_Z
 from .verdict import THRESHOLDS
 
@@ -68,8 +69,8 @@ SPECIAL = ("no significant gap", "unexplained")
 
 def _judged_on(hd: dict) -> str:
     """Where one linkage channel was judged on its own (heldout._judged_channel): which."""
-    on = hd.get("judged_on", "every channel")
-    return "" if on == "every channel" else f" (`{on}` on its own before)"
+    on = hd["judged_on"]
+    return "" if on == POOLED else f" (`{on}` on its own before)"
 
 
 def words(label: str) -> str:
@@ -279,7 +280,7 @@ class Report:
             "ratio_before": held.ratio_before,
             "ratio_after": held.ratio_after,
             # a linkage channel judged on its own (heldout._judged_channel), or the pool
-            "judged_on": held.extra.get("judged_on", "every channel"),
+            "judged_on": held.extra.get("judged_on", POOLED),
             "gap_before": held.gap_before,
             "gap_after": held.gap_after,
             "shrink": held.shrink,
