@@ -250,6 +250,61 @@ def test_count_loss_at_a_rate_ceiling_recovers_the_hidden_speed() -> None:
 
 
 
+def test_a_rate_ceiling_is_reached_at_the_rate_the_counts_show() -> None:
+    """model.count_loss_plateau: one wheel reaches the decoder's ceiling twice, from rest at its
+    drive's 2 m/s^2 and from a cruise just below it at 0.2 m/s^2 (a gentler speed change), to
+    the same hidden speed each time. Each stretch's hidden speed goes on at the rate its own
+    counts came in and go out at, so with the drive's a and the true excess both stretches'
+    lost travel comes back; one rate for both (the law before) misses one or the other."""
+    from odo_tools.gap.model import Prepared, count_loss_plateau, plateau_level
+
+    dt, ceil, vmax, step = 0.04, 600.0, 800.0, 1e-4
+
+    def ramp(v0: float, v1: float, a: float) -> np.ndarray:
+        return v0 + np.sign(v1 - v0) * np.minimum(np.arange(0.0, 4.0, step) * a, abs(v1 - v0))
+
+    def hold(v: float, s: float) -> np.ndarray:
+        return np.full(round(s / step), v)
+
+    v = np.concatenate([hold(0.0, 0.4), ramp(0.0, vmax, 2000.0)[: round(0.4 / step)],
+                        hold(vmax, 2.0), ramp(vmax, 300.0, 2000.0)[: round(0.25 / step)],
+                        hold(300.0, 1.0), ramp(300.0, 560.0, 2000.0)[: round(0.13 / step)],
+                        hold(560.0, 1.0), ramp(560.0, vmax, 200.0)[: round(1.2 / step)],
+                        hold(vmax, 3.0), ramp(vmax, 0.0, 2000.0)[: round(0.4 / step)],
+                        hold(0.0, 0.8)])  # fmt: skip
+    per = round(dt / step)
+    v = v[: v.size // per * per]
+    true = v.reshape(-1, per).sum(axis=1) * step  # mm per tick
+    counted = np.minimum(v, ceil).reshape(-1, per).sum(axis=1) * step
+    ds = counted[:, None, None] * np.ones((1, 1, 2))
+    n = counted.size + 1
+    S = np.concatenate([np.zeros((1, 1, 2)), np.cumsum(np.abs(ds), axis=0)])
+    pr = Prepared(None, np.arange(n) * dt, ds, S, [400.0], [75.0], np.full(n - 1, dt))
+    assert plateau_level([pr]) == pytest.approx(ceil, rel=1e-9)
+    second = np.arange(true.size) * dt > 4.5  # the gentle stretch and what follows
+    lost = [
+        true[~second].sum() - counted[~second].sum(),
+        true[second].sum() - counted[second].sum(),
+    ]
+    assert min(lost) > 150.0  # each stretch lost 15 cm or more
+
+    def travel(a: float) -> list[float]:
+        P = {"count_loss@plateau.level_mm_s": ceil, "count_loss@plateau.excess_mm_s": vmax - ceil,
+             "count_loss@plateau.a_m_s2": a}  # fmt: skip
+        got = count_loss_plateau(pr, pr.ds[:, 0, :].copy(), 0, P)[:, 0]
+        return [
+            got[~second].sum() - counted[~second].sum(),
+            got[second].sum() - counted[second].sum(),
+        ]
+
+    for got, want in zip(travel(2.0), lost, strict=True):
+        assert got == pytest.approx(want, rel=0.03)
+    # the one-rate law (2 m/s^2 on both ramps: E T - E^2 / a over a stretch of length T)
+    # over-counts the gentle stretch by about 9 cm
+    E, T = vmax - ceil, dt * np.count_nonzero(second & (counted >= ceil * dt * (1 - 1e-9)))
+    assert abs(E * T - E * E / 2000.0 - lost[1]) > 0.1 * lost[1]
+
+
 def test_a_rate_ceiling_is_found_under_jittered_stamps() -> None:
     """model.counted_speed: a decoder at its ceiling counts the same per tick; a log stamped on
     arrival jitters the recorded tick lengths (here +-0.7 % on 10 ms) without the counts

@@ -203,8 +203,16 @@ def test_no_drive_effect_is_fitted_on_a_passive_trailer() -> None:
 def test_rate_ceiling_law_over_every_stretch_at_once_is_the_per_stretch_loop_bit_for_bit() -> None:
     """model.count_loss_plateau adds the hidden travel of every saturated tick of both wheels
     in one step (`_plateau_stretches` keeps them as flat arrays); the form it replaced looped
-    over the stretches, one numpy expression each."""
-    from odo_tools.gap.model import PLATEAU_SUB, PLATEAU_TOL, count_loss_plateau, counted_speed
+    over the stretches, one numpy expression each, each stretch's ramps read from its counts
+    (at most the law's a)."""
+    from odo_tools.gap.model import (
+        PLATEAU_SUB,
+        PLATEAU_TOL,
+        RAMP_MIN_MM_S2,
+        RAMP_S,
+        count_loss_plateau,
+        counted_speed,
+    )
 
     rng = np.random.default_rng(11)
     ds = _wheels(rng, 1200)
@@ -212,6 +220,18 @@ def test_rate_ceiling_law_over_every_stretch_at_once_is_the_per_stretch_loop_bit
     pr.dt = 0.02 + rng.uniform(0.0, 1e-4, ds.shape[0])
     pr.t = np.concatenate([[0.0], np.cumsum(pr.dt)])
     level = float(np.percentile(np.abs(ds) / pr.dt[:, None], 80))  # a fifth of the ticks saturate
+    v = counted_speed(pr, 0)  # the wheel speed it reads
+    tm = pr.t[:-1] + 0.5 * pr.dt
+    k = max(1, round(RAMP_S / float(np.median(pr.dt))))
+
+    def rate(w: int, near: int, far: int) -> float:  # the counts' ramp into or out of it
+        if not 0 <= near < v.shape[0]:
+            return math.inf
+        far = min(max(far, 0), v.shape[0] - 1)
+        if far == near:
+            return math.inf
+        return max((v[near, w] - v[far, w]) / abs(tm[near] - tm[far]), RAMP_MIN_MM_S2)
+
     for E, a in ((0.4 * level, 2.0), (3.0 * level, 0.3)):
         P = {
             "count_loss@plateau.level_mm_s": level,
@@ -219,7 +239,7 @@ def test_rate_ceiling_law_over_every_stretch_at_once_is_the_per_stretch_loop_bit
             "count_loss@plateau.a_m_s2": a,
         }
         want = ds.copy()
-        sat = counted_speed(pr, 0) >= level * (1.0 - PLATEAU_TOL)  # the wheel speed it reads
+        sat = v >= level * (1.0 - PLATEAU_TOL)
         f = (np.arange(PLATEAU_SUB) + 0.5) / PLATEAU_SUB
         stretches = 0
         for w in (0, 1):  # the form it replaced: one stretch at a time
@@ -228,7 +248,9 @@ def test_rate_ceiling_law_over_every_stretch_at_once_is_the_per_stretch_loop_bit
             for i0, i1 in zip(up, down, strict=True):
                 tau = pr.t[i0:i1, None] - pr.t[i0] + f[None, :] * pr.dt[i0:i1, None]
                 T, am = pr.t[i1] - pr.t[i0], a * 1e3
-                ex = np.minimum(np.minimum(am * tau, am * (T - tau)), E)
+                r_in, r_out = rate(w, i0 - 1, i0 - 1 - k), rate(w, i1, i1 + k)
+                r_in, r_out = (r if math.isinf(r) else min(r, am) for r in (r_in, r_out))
+                ex = np.minimum(np.minimum(r_in * tau, r_out * (T - tau)), E)
                 want[i0:i1, w] += np.sign(ds[i0:i1, w]) * ex.mean(axis=1) * pr.dt[i0:i1]
                 stretches += 1
         assert stretches > 10  # stretches on both wheels: the comparison covers the flat layout

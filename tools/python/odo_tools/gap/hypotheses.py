@@ -160,7 +160,8 @@ OTHER_LAWS = {
             "plateau",
             ("count_loss@plateau.excess_mm_s", "count_loss@plateau.a_m_s2"),
             "a count-rate ceiling: the counts sit on a flat top while the hidden wheel speed "
-            "rises at a to the ceiling + excess and back",
+            "goes on to the ceiling + excess at the rate the counts rose into it (at most a) "
+            "and back at the rate they fall out of it",
         ),
         Law(
             "count_loss",

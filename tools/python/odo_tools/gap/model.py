@@ -554,12 +554,20 @@ def plateau_level(prs: list, truck: int = 0) -> float:
 def count_loss_plateau(pr: Prepared, ds: np.ndarray, truck: int, P: dict) -> np.ndarray:
     """Counts lost at a hard rate limit: a decoder that takes at most so many edges per second
     counts the ceiling `level` however fast the wheel runs, so its counts sit on a flat top
-    while the wheel's true speed, hidden, goes on rising at the drive's acceleration a to the
-    speed V it was commanded, holds and comes back down to the ceiling where the counts leave
-    the top. Per stretch of saturated ticks of a wheel, the travel beyond the counted is the
-    integral of min(a tau, a (T - tau), V - level) over the tick (tau from the stretch's start,
-    T its length). V - level (`excess_mm_s`) and a are the law's parameters; the ceiling comes
-    from the counts (`plateau_level`)."""
+    while the wheel's true speed, hidden, goes on rising to the speed V it was commanded, holds
+    and comes back down to the ceiling where the counts leave the top. It rises at the rate the
+    counts rose just before they reached the top, and falls at the rate they fall just after
+    (`_ramp_rates`), at most at the drive's acceleration a. One drive reached its ceiling at
+    1.0 m/s^2 from rest and at 0.2 m/s^2 from a cruise just below it; one rate for both (a
+    fitted 0.38) left the held-out runs at 108 x the background, "unexplained", and the
+    counts' own rates (a 0.91, the cap) at 39 x, named: the half of a sprint run held out at
+    1.2 mm (6.5 mm before), the other at 261 mm for a turn of 11 deg the robot made while
+    both its wheels sat on the ceiling, which no count shows (independent world, seed 3261
+    case 19). Per stretch of saturated
+    ticks of a wheel, the travel beyond the counted is the integral of min(min(a_in, a) tau,
+    min(a_out, a) (T - tau), V - level) over the tick (tau from the stretch's start, T its
+    length). V - level (`excess_mm_s`) and a are the law's parameters; the ceiling and the
+    rates come from the counts (`plateau_level`)."""
     level = P["count_loss@plateau.level_mm_s"]
     E = P.get("count_loss@plateau.excess_mm_s", 0.0)
     a = P.get("count_loss@plateau.a_m_s2", 1.0) * 1e3
@@ -568,25 +576,54 @@ def count_loss_plateau(pr: Prepared, ds: np.ndarray, truck: int, P: dict) -> np.
     out = ds.copy()
     st = _plateau_stretches(pr, truck, level)
     if st is not None:  # every saturated tick of both wheels at once (they never overlap)
-        rows, cols, tau, T, sg, dt = st
-        ex = np.minimum(np.minimum(a * tau, a * (T - tau)), E)
+        rows, cols, tau, left, a_in, a_out, sg, dt = st
+        # a ramp a cut left out of the run (infinite) is not capped: the wheel is already there
+        rise = np.where(np.isinf(a_in), np.inf, np.minimum(a_in, a)) * tau  # tau, left > 0
+        fall = np.where(np.isinf(a_out), np.inf, np.minimum(a_out, a)) * left
+        ex = np.minimum(np.minimum(rise, fall), E)
         out[rows, cols] += sg * ex.mean(axis=1) * dt
     return out
 
 
+RAMP_S = 0.1  # the counts' rise into a ceiling (and fall out of it) is read over this long
+RAMP_MIN_MM_S2 = 50.0  # ... and taken as at least this steep
+
+
+def _ramp_rates(v: np.ndarray, tm: np.ndarray, i0: int, i1: int, k: int) -> tuple[float, float]:
+    """The rates (mm/s^2) at which a wheel's counted speed v (per tick, tick centres tm) rose
+    into its saturated ticks i0..i1-1 and fell out of them, each read over k ticks (RAMP_S)
+    before and after; infinite where the run starts or ends inside the stretch (a half cut
+    there: the ramp is not in it)."""
+    rates = []
+    for far, near in ((i0 - 1 - k, i0 - 1), (i1 + k, i1)):
+        if near < 0 or near >= v.size:
+            rates.append(math.inf)
+            continue
+        far = min(max(far, 0), v.size - 1)
+        if far == near:
+            rates.append(math.inf)
+            continue
+        rates.append(max((v[near] - v[far]) / abs(tm[near] - tm[far]), RAMP_MIN_MM_S2))
+    return rates[0], rates[1]
+
+
 def _plateau_stretches(pr: Prepared, truck: int, level: float) -> tuple | None:
     """Every saturated tick of a wheel, in stretches, as flat arrays: (tick, wheel, (ticks,
-    sub-steps) times since its stretch began, (ticks, 1) the stretch's length, the wheel's
-    direction, the tick's length); None where no tick saturates. Independent of the law's
-    parameters, so a fit that moves them reuses it (cached per truck and ceiling)."""
+    sub-steps) times since its stretch began and still to its end, (ticks, 1) the rates its
+    counts rose into it and fell out of it (_ramp_rates), the wheel's direction, the tick's
+    length); None where no tick saturates. Independent of the law's parameters, so a fit that
+    moves them reuses it (cached per truck and ceiling)."""
     key = ("plateau", truck, level)
     if key in pr.slip_cache:
         return pr.slip_cache[key]
     t = pr.t
     raw = pr.ds[:, truck, :]
-    sat = counted_speed(pr, truck) >= level * (1.0 - PLATEAU_TOL)
+    v = counted_speed(pr, truck)
+    tm = t[:-1] + 0.5 * pr.dt
+    sat = v >= level * (1.0 - PLATEAU_TOL)
+    k = max(1, round(RAMP_S / float(np.median(pr.dt))))
     f = (np.arange(PLATEAU_SUB) + 0.5) / PLATEAU_SUB
-    parts: list[list[np.ndarray]] = [[] for _ in range(6)]
+    parts: list[list[np.ndarray]] = [[] for _ in range(8)]
     for w in (0, 1):
         m = np.concatenate([[False], sat[:, w], [False]]).astype(np.int8)
         starts = np.flatnonzero(np.diff(m) == 1)
@@ -594,8 +631,17 @@ def _plateau_stretches(pr: Prepared, truck: int, level: float) -> tuple | None:
         for i0, i1 in zip(starts, ends, strict=True):
             tau = t[i0:i1, None] - t[i0] + f[None, :] * pr.dt[i0:i1, None]
             n = i1 - i0
-            T = np.full((n, 1), t[i1] - t[i0])
-            got = (np.arange(i0, i1), np.full(n, w), tau, T, np.sign(raw[i0:i1, w]), pr.dt[i0:i1])
+            a_in, a_out = _ramp_rates(v[:, w], tm, i0, i1, k)
+            got = (
+                np.arange(i0, i1),
+                np.full(n, w),
+                tau,
+                t[i1] - t[i0] - tau,
+                np.full((n, 1), a_in),
+                np.full((n, 1), a_out),
+                np.sign(raw[i0:i1, w]),
+                pr.dt[i0:i1],
+            )
             for p, g in zip(parts, got, strict=True):
                 p.append(g)
     flat = tuple(np.concatenate(p) for p in parts) if parts[0] else None
