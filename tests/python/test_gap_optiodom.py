@@ -60,8 +60,11 @@ def test_return_errors_name_tyre_scrub_and_shrink_fivefold(sessions, tmp_path: P
 
 
 def test_the_track_names_tyre_scrub_too(sessions, tmp_path: Path) -> None:
+    """... and sizes it as the track does: the windows' best (Es + scrub + slip, k 0.0208) lost
+    Es and the slip on the tracks, and the scrub that stayed is the one it was beside, not the
+    windows' lone scrub (k 0.0274, the held-out return error 43 -> 15 mm)."""
     rep = _diagnose(sessions, tmp_path)
     assert rep["mode"] == "truth"
     assert "scrub" in rep["verdict"]["effect"].split("+"), rep["verdict"]
     h = rep["heldout"]
-    assert h["return_mm_before"] > 2.0 * h["return_mm_after"], h
+    assert h["return_mm_before"] >= 5.0 * h["return_mm_after"], h
