@@ -53,3 +53,17 @@ def test_a_speed_dependent_ed_is_named_ed_with_its_law(tmp_path: Path) -> None:
     assert p["ed@growth.g_per_m2_s2"] == pytest.approx(e["g_left"], rel=0.15)
     assert p["ed.value"] == pytest.approx(e["value0"], abs=3e-4)
     assert rep["heldout"]["ratio_after"] < 1.5
+
+
+def test_a_right_tyre_that_grows_is_found_in_its_own_basin(tmp_path: Path) -> None:
+    """Dev seed 4091 case 33: the right tyre grows by g = 0.00829 per (m/s)^2 beside a fixed Ed
+    of 0.99529. The law's sign picks the wheel (g < 0: the right), and a solver started at 0
+    walks to g > 0 only: the left tyre growing fitted the tracks worse than count loss did
+    ("count loss", 7.1 x the background). Each start is mirrored too (fit.WHEEL_SIGNED)."""
+    c, rep = indep_named(4091, 33, tmp_path, "labmate", {"ed": "speed"}, "ed", "growth")
+    e = c["true"]["effects"]["ed"]
+    assert e["g_left"] == 0.0
+    p = rep["verdict"]["params"]
+    assert p["ed@growth.g_per_m2_s2"] == pytest.approx(-e["g_right"], rel=0.15)
+    assert p["ed.value"] == pytest.approx(e["value0"], abs=3e-4)
+    assert rep["heldout"]["ratio_after"] < 1.5
