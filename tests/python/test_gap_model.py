@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import math
 import shutil
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -303,6 +304,15 @@ def test_a_rate_ceiling_is_reached_at_the_rate_the_counts_show() -> None:
     # over-counts the gentle stretch by about 9 cm
     E, T = vmax - ceil, dt * np.count_nonzero(second & (counted >= ceil * dt * (1 - 1e-9)))
     assert abs(E * T - E * E / 2000.0 - lost[1]) > 0.1 * lost[1]
+    # a run of one tick or none has no stretch and no ramp to read: its counts come back
+    P = {"count_loss@plateau.level_mm_s": ceil, "count_loss@plateau.excess_mm_s": vmax - ceil}
+    for m in (1, 0):
+        d = np.zeros((m, 1, 2))
+        few = Prepared(None, np.arange(m + 1) * dt, d, np.zeros((m + 1, 1, 2)), [400.0], [75.0],
+                       np.full(m, dt))  # fmt: skip
+        with np.errstate(all="ignore"), warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)  # the median tick of no tick
+            assert count_loss_plateau(few, d[:, 0, :].copy(), 0, P).shape == (m, 2)
 
 
 def test_a_rate_ceiling_is_found_under_jittered_stamps() -> None:

@@ -621,7 +621,7 @@ def _plateau_stretches(pr: Prepared, truck: int, level: float) -> tuple | None:
     v = counted_speed(pr, truck)
     tm = t[:-1] + 0.5 * pr.dt
     sat = v >= level * (1.0 - PLATEAU_TOL)
-    k = max(1, round(RAMP_S / float(np.median(pr.dt))))
+    k = max(1, round(RAMP_S / float(np.median(pr.dt)))) if sat.any() else 1
     f = (np.arange(PLATEAU_SUB) + 0.5) / PLATEAU_SUB
     parts: list[list[np.ndarray]] = [[] for _ in range(8)]
     for w in (0, 1):
