@@ -1217,8 +1217,8 @@ def _kept_sizes(sub: Fit, parent: Fit, prob: Problem) -> Fit | None:
     beside the others, where the parent carries them all (None otherwise). The windows' own fit
     of a lone member can walk off what the tracks say: OptiOdom's "es + scrub + slip" (scrub k
     0.0208, the accumulated track's own fit 0.0210) lost Es and the slip on the tracks, and the
-    windows' scrub alone, k 0.0274, left the held-out circles at 15.1 mm where 0.021 leaves
-    5.0 mm."""
+    windows' scrub alone, k 0.0274, left the held-out circles at 15.1 mm where 0.0208 leaves
+    5.1 mm."""
     if sub.hyp is None or sub.hyp.has_bumps:
         return None
     P = parent.model_params()

@@ -563,11 +563,10 @@ def count_loss_plateau(pr: Prepared, ds: np.ndarray, truck: int, P: dict) -> np.
     counts' own rates (a 0.91, the cap) at 39 x, named: the half of a sprint run held out at
     1.2 mm (6.5 mm before), the other at 261 mm for a turn of 11 deg the robot made while
     both its wheels sat on the ceiling, which no count shows (independent world, seed 3261
-    case 19). Per stretch of saturated
-    ticks of a wheel, the travel beyond the counted is the integral of min(min(a_in, a) tau,
-    min(a_out, a) (T - tau), V - level) over the tick (tau from the stretch's start, T its
-    length). V - level (`excess_mm_s`) and a are the law's parameters; the ceiling and the
-    rates come from the counts (`plateau_level`)."""
+    case 19). Per stretch of saturated ticks of a wheel, the travel beyond the counted is the
+    integral of min(min(a_in, a) tau, min(a_out, a) (T - tau), V - level) over the tick (tau
+    from the stretch's start, T its length). V - level (`excess_mm_s`) and a are the law's
+    parameters; the ceiling (`plateau_level`) and the rates come from the counts."""
     level = P["count_loss@plateau.level_mm_s"]
     E = P.get("count_loss@plateau.excess_mm_s", 0.0)
     a = P.get("count_loss@plateau.a_m_s2", 1.0) * 1e3
