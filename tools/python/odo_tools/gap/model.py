@@ -615,12 +615,15 @@ def _plateau_stretches(pr: Prepared, truck: int, level: float) -> tuple | None:
     key = ("plateau", truck, level)
     if key in pr.slip_cache:
         return pr.slip_cache[key]
+    v = counted_speed(pr, truck)
+    sat = v >= level * (1.0 - PLATEAU_TOL)
+    if not sat.any():  # nothing saturates (and a run of one tick has no median tick to read)
+        _cache_put(pr.slip_cache, key, None)
+        return None
     t = pr.t
     raw = pr.ds[:, truck, :]
-    v = counted_speed(pr, truck)
     tm = t[:-1] + 0.5 * pr.dt
-    sat = v >= level * (1.0 - PLATEAU_TOL)
-    k = max(1, round(RAMP_S / float(np.median(pr.dt)))) if sat.any() else 1
+    k = max(1, round(RAMP_S / float(np.median(pr.dt))))
     f = (np.arange(PLATEAU_SUB) + 0.5) / PLATEAU_SUB
     parts: list[list[np.ndarray]] = [[] for _ in range(8)]
     for w in (0, 1):
@@ -643,7 +646,7 @@ def _plateau_stretches(pr: Prepared, truck: int, level: float) -> tuple | None:
             )
             for p, g in zip(parts, got, strict=True):
                 p.append(g)
-    flat = tuple(np.concatenate(p) for p in parts) if parts[0] else None
+    flat = tuple(np.concatenate(p) for p in parts)
     _cache_put(pr.slip_cache, key, flat)
     return flat
 
