@@ -217,7 +217,8 @@ def floor_travel(
     if drive and P.get("slip@accel.k_per_m_s2", 0.0) > 0:
         ds = slip_accel(pr, ds, P)
     if drive and P.get("slip@traction.a_max_m_s2", 0.0) > 0:
-        ds = slip_traction(pr, ds, P["slip@traction.a_max_m_s2"], b)
+        q = pr.count_mm[truck] if pr.count_mm else 0.0
+        ds = slip_traction(pr, ds, P["slip@traction.a_max_m_s2"], b, q)
     if drive and P.get("slip@motor.a_max_m_s2", 0.0) > 0:
         ds = slip_motor(pr, ds, P["slip@motor.a_max_m_s2"], P.get("slip@motor.tau_s", 0.02), b)
     if P.get("count_loss@speed.k_per_m_s", 0.0) > 0:
@@ -336,21 +337,52 @@ ACCEL_SPAN_S = 0.05  # slip_accel reads speeds over +- this much time where tick
 def _span_speeds(pr: Prepared, ds: np.ndarray) -> np.ndarray:
     """(n-1, 2) wheel speeds (mm/s) as slip_accel differences them: where ACCEL_SPAN_S holds
     two ticks or more, each tick's mean from the counts averaged with its neighbours' within +-
-    ACCEL_SPAN_S (triangular weights; the first and last speed repeated beyond the run's ends),
-    else _wheel_speeds'. Three ticks are too few where ticks are short: a LabMate's 0.6 mm edges
-    on 10 ms ticks jump the counted speed by 60 mm/s per edge, an acceleration of several m/s^2
-    between neighbouring ticks, and the law's threshold a0 was fitted to that jitter (0.50 m/s^2
-    against a true law with none; independent world, dev seed 4091 case 34, held-out 7.8 ->
-    8.6 x the background; over +- 50 ms 9.7 -> 2.3, and two of 17 acceleration slips of dev
-    seeds 4021-4101 named that were not)."""
+    ACCEL_SPAN_S (`_tri_speeds`), else _wheel_speeds'. Three ticks are too few where ticks are
+    short: a LabMate's 0.6 mm edges on 10 ms ticks jump the counted speed by 60 mm/s per edge,
+    an acceleration of several m/s^2 between neighbouring ticks, and the law's threshold a0
+    was fitted to that jitter (0.50 m/s^2 against a true law with none; independent world, dev
+    seed 4091 case 34, held-out 7.8 -> 8.6 x the background; over +- 50 ms 9.7 -> 2.3, and two
+    of 17 acceleration slips of dev seeds 4021-4101 named that were not)."""
     h = round(ACCEL_SPAN_S / float(np.median(pr.dt)))
     if h <= 1 or ds.shape[0] < 3:
         return _wheel_speeds(pr, ds)
+    return _tri_speeds(pr, ds, h)
+
+
+def _tri_speeds(pr: Prepared, ds: np.ndarray, h: int) -> np.ndarray:
+    """(n-1, 2) each tick's mean speed from the counts averaged with its neighbours' within +-
+    (h - 1) ticks, triangular weights (h = 2: SPEED_KERNEL's), the first and last speed
+    repeated beyond the run's ends."""
     v = ds / pr.dt[:, None]
     w = np.concatenate([np.arange(1, h + 1), np.arange(h - 1, 0, -1)]).astype(float)
     w /= w.sum()
     pad = np.concatenate([np.repeat(v[:1], h - 1, axis=0), v, np.repeat(v[-1:], h - 1, axis=0)])
     return np.column_stack([np.convolve(pad[:, j], w, mode="valid") for j in range(2)])
+
+
+# the jitter whole edges may leave in the change of speed between ticks that a grip law reads
+# (_grip_speeds): below the grips real floors give (0.5-1.5 m/s^2 for a LabMate's tyres)
+GRIP_JITTER_MM_S2 = 1000.0
+
+
+def _grip_speeds(pr: Prepared, ds: np.ndarray, q: float) -> np.ndarray:
+    """(n-1, 2) wheel speeds (mm/s) as the grip laws rate-limit them, on counts of q mm edges:
+    _wheel_speeds' where that leaves the speed change between ticks within GRIP_JITTER_MM_S2
+    of the edges' jitter, else each tick's mean averaged over the fewest neighbours that do
+    (`_tri_speeds`). Over a triangle of half-width h ticks of length T, whole edges move the
+    change of speed from one tick to the next by up to 2 q / (h T)^2: 0.11 m/s^2 for 0.35 mm
+    edges on 40 ms ticks with h = 2 (the three ticks of _wheel_speeds), but 11.6 m/s^2 for a
+    LabMate's 2.3 mm edges on 10 ms ticks, where the traction law spun the wheels on ticks the
+    floor gripped and took the tracks further off at any grip (independent world, fresh seed
+    3281 case 12: a 1.20 m/s^2 limit "unexplained"; read over +- 60 ms, 1.21 fitted and
+    named). Not slip_accel's fixed +- 50 ms: fine edges on short ticks keep the three ticks,
+    whose starts the traction law follows closely (dev seed 2791 case 51, 0.12 mm edges on
+    10 ms ticks: held out at 1.6 x the background, 14 x read as slip_accel reads them)."""
+    T = float(np.median(pr.dt))
+    h = math.ceil(math.sqrt(2.0 * q / (GRIP_JITTER_MM_S2 * T * T)) - 1e-9) if q > 0 else 0
+    if h <= 2 or ds.shape[0] < 3:
+        return _wheel_speeds(pr, ds)
+    return _tri_speeds(pr, ds, h)
 
 
 def slip_accel(pr: Prepared, ds: np.ndarray, P: dict) -> np.ndarray:
@@ -373,16 +405,18 @@ def slip_accel(pr: Prepared, ds: np.ndarray, P: dict) -> np.ndarray:
     return ds * np.where(up, 1.0 - s, 1.0 / (1.0 - s))
 
 
-def slip_traction(pr: Prepared, ds: np.ndarray, a_max: float, b: float) -> np.ndarray:
+def slip_traction(
+    pr: Prepared, ds: np.ndarray, a_max: float, b: float, q: float = 0.0
+) -> np.ndarray:
     """Slip at traction (torque) saturation: the floor speed follows the wheel's surface speed
     but changes by at most what the friction circle leaves beside the turn's lateral
     acceleration, sqrt(a_max^2 - (v w)^2) (m/s^2, at least a tenth of a_max); the wheel spins
     while it is ahead and drags while it is behind. One rate limiter per wheel, tick by tick, on
-    the speeds _wheel_speeds reads; the floor travel is the counted one less what the wheel ran
-    ahead.
+    the speeds _grip_speeds reads from q mm edges; the floor travel is the counted one less what
+    the wheel ran ahead.
     Without the circle, starts on a 0.75 m/s arc spun far more than the law allowed (independent
     world, seed 2701 case 21: a circle left at 108 mm after the fit)."""
-    v = _wheel_speeds(pr, ds)
+    v = _grip_speeds(pr, ds, q)
     lim = _grip(a_max, v[:, 0], v[:, 1], b) * pr.dt  # mm/s per tick
     out = ds.copy()
     for w in (0, 1):
