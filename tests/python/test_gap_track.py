@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 from gap_support import indep_case, indep_named
 from odo_tools.gap import diagnose as D
+from odo_tools.gap import hypotheses
 from odo_tools.gap.fit import Problem
 from odo_tools.validation import indep
 
@@ -326,6 +327,30 @@ def test_an_es_the_tracks_choose_is_the_floor_when_the_walk_accounts_for_it(
     assert "es fitted to the tracks" in rep["proposals"]["the accumulated track"]
     rep = D.diagnose(real, real / "robot.json", mode="truth").to_dict()
     assert rep["verdict"]["effect"] == "roughness", rep["verdict"]
+
+
+def test_a_rough_surface_that_shortens_more_than_grains_is_still_the_floor(tmp_path: Path) -> None:
+    """Dev seed 4131 case 57: a LabMate on a continuous rough surface, which shortens travel
+    more for the walk it makes than the catalog's grains do. Its Es (1.0057) was 2.3 x what
+    grains walking as much as the measured floor would give, outside the floor's factor of 2:
+    "es". Within diagnose.FLOOR_RATIO it is the floor, and an Es whose shortening the floor's
+    walk does not account for stays an Es (its ratio on the same walk, beyond the factor)."""
+    from odo_tools.gap.model import rough_moments
+
+    real = tmp_path / "real"
+    indep_case(4131, 57, real, "labmate", {"roughness": "surface"})
+    ds = D.load(real, real / "robot.json", "truth")
+    sel = D.select_runs(ds)
+    rk = D.rank(ds, sel)
+    assert rk.best.hyp is not None and "roughness" in rk.best.hyp.families, rk.best.name
+    es = rk.best.params["es.value"]
+    m1, _ = rough_moments(rk.prob.items[0].pr.R[0], rk.prob.rough_from_walk())
+    ratio = (1.0 - 1.0 / es) / (m1 / 20.0)
+    assert 2.0 < ratio <= D.FLOOR_RATIO  # named Es with a factor of 2
+    scale = 1.0 / (1.0 - D.FLOOR_RATIO * 1.2 * m1 / 20.0)
+    big = D.Fit(rk.best.name, {**rk.best.params, "es.value": scale}, {}, 0.0, 0.0, 1, 1, [],
+                hypotheses.Hypothesis((hypotheses.catalog_law("es", "labmate"),)))  # fmt: skip
+    assert D._floor_or_scale(big, rk.prob, "labmate").hyp.families == ("es",)
 
 
 def test_a_linkage_bias_beside_the_tracks_geometry_must_earn_its_place(tmp_path: Path) -> None:
