@@ -60,3 +60,48 @@ def test_a_constant_ed_holds_still_run_by_run(tmp_path: Path) -> None:
     rep = _diagnose(2761, 38, tmp_path, {"ed": "fixed"})
     assert rep["verdict"]["effect"] == "ed", rep["verdict"]
     assert not [f for f in rep["stability"]["findings"] if f["kind"] == "time"]
+
+
+def test_a_wheel_that_warms_run_after_run_over_many_paths_is_unexplained(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Independent world, dev seed 4151 case 28: a LabMate whose Es rose run after run over
+    nine runs of several paths, 1.0002 to 1.0058, while no moment split the runs of one path
+    by verdict.DRIFT_Z: "ed" was named. The order of the values alone, by Kendall's rank
+    correlation with the order of recording (stability._trend), makes it "unexplained"."""
+    from odo_tools.gap import stability
+
+    rep = _diagnose(4151, 28, tmp_path / "a", {"diameter_drift": "thermal"})
+    assert rep["verdict"]["effect"] == "unexplained", rep["verdict"]
+    (f,) = [f for f in rep["stability"]["findings"] if f["kind"] == "time"]
+    assert f["param"] == "es.value" and f["values"][1] > f["values"][0], f
+    assert f["implies"]["p"] <= rep["thresholds"]["geometry_drift_trend_p"]
+    assert "run after run" in rep["verdict"]["reason"]
+    monkeypatch.setattr(stability, "_trend", lambda keys, per: None)
+    rep = _diagnose(4151, 28, tmp_path / "b", {"diameter_drift": "thermal"})
+    assert rep["verdict"]["effect"] == "ed", rep["verdict"]  # the moments alone miss it
+
+
+def test_a_value_that_depends_on_the_path_is_no_trend() -> None:
+    """Ranks ask nothing of the paths, so the trend test must not take a path-dependent value
+    for a drift: five circles, then five squares, each path at its own value with scatter, give
+    no finding; the same values in the order a warming wheel gives them, one."""
+    from types import SimpleNamespace
+
+    import numpy as np
+    from odo_tools.gap.stability import _trend
+
+    rng = np.random.default_rng(3)
+
+    def per(values):
+        return [
+            (SimpleNamespace(run=SimpleNamespace(name=f"run-{i:02d}")), {"es.value": v},
+             {"es.value": 2e-4})
+            for i, v in enumerate(values)
+        ]  # fmt: skip
+
+    blocks = np.r_[1.0058 + rng.normal(0, 2e-4, 5), 1.0076 + rng.normal(0, 2e-4, 5)]
+    assert _trend(["es.value"], per(blocks)) is None
+    warming = 1.0 + 0.006 * (1.0 - np.exp(-np.arange(10) / 4.0)) + rng.normal(0, 2e-4, 10)
+    f = _trend(["es.value"], per(warming))
+    assert f is not None and f.implies["kendall_tau"] > 0.8, f

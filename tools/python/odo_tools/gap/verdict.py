@@ -39,6 +39,9 @@ EXCESS_REMOVED = 0.75  # ... or it removes this share of the held-out misfit abo
 # moment by this many standard errors: a parameter drifting in time, which no catalog effect is
 # (stability.drift), and the verdict is "unexplained"
 DRIFT_Z = 4.0
+# ... or its per-run value rises or falls run after run, whatever path each drove: Kendall's rank
+# correlation with the order of recording at a p-value at most DRIFT_TREND_P (stability.drift)
+DRIFT_TREND_P = 1e-4
 
 GAP_QUANTILE = 0.99  # a background estimated from few runs: R^2 beyond F(n, dof)'s 99 %
 
@@ -144,4 +147,5 @@ THRESHOLDS = {
     "heldout_excess_removed_named": EXCESS_REMOVED,
     "heldout_gap_quantile_few_dof": GAP_QUANTILE,
     "geometry_drift_z": DRIFT_Z,
+    "geometry_drift_trend_p": DRIFT_TREND_P,
 }
