@@ -45,6 +45,10 @@ class Prepared:
     track_cache: dict = field(default_factory=dict, repr=False)  # _track results by parameters
     clamp_cache: dict = field(default_factory=dict, repr=False)  # _clamp_link pushes by tracks
 
+    def edge_mm(self, truck: int) -> float:
+        """A truck's wheel travel per counted edge (mm); 0 where the robot's counts are unknown."""
+        return self.count_mm[truck] if truck < len(self.count_mm) else 0.0
+
 
 def prepare(run: RunData, robot: Robot) -> Prepared:
     c = run.log.counts.astype(np.int64)
@@ -217,8 +221,7 @@ def floor_travel(
     if drive and P.get("slip@accel.k_per_m_s2", 0.0) > 0:
         ds = slip_accel(pr, ds, P)
     if drive and P.get("slip@traction.a_max_m_s2", 0.0) > 0:
-        q = pr.count_mm[truck] if pr.count_mm else 0.0
-        ds = slip_traction(pr, ds, P["slip@traction.a_max_m_s2"], b, q)
+        ds = slip_traction(pr, ds, P["slip@traction.a_max_m_s2"], b, pr.edge_mm(truck))
     if drive and P.get("slip@motor.a_max_m_s2", 0.0) > 0:
         ds = slip_motor(pr, ds, P["slip@motor.a_max_m_s2"], P.get("slip@motor.tau_s", 0.02), b)
     if P.get("count_loss@speed.k_per_m_s", 0.0) > 0:
@@ -554,7 +557,7 @@ def counted_speed(pr: Prepared, truck: int) -> np.ndarray:
     rec = d / pr.dt[:, None]
     nom = d / float(np.median(pr.dt))
     # neighbouring ticks of a wheel that moves by at least COUNTED_MIN counts in both
-    step = pr.count_mm[truck] if pr.count_mm else 0.0
+    step = pr.edge_mm(truck)
     both = np.minimum(d[1:], d[:-1]) >= max(COUNTED_MIN * step, 1e-12)
     out = rec
     if both.any():

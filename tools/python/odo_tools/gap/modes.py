@@ -413,7 +413,7 @@ class TruthMode:
             return got
         out = np.zeros((self.i.size, len(self.channels())))
         for t in range(self.trucks):
-            c = self.pr.count_mm[t] if t < len(self.pr.count_mm) else 0.0
+            c = self.pr.edge_mm(t)
             if c <= 0:
                 continue
             travel = np.abs(self.wtravel[t])  # (2, nwin) each wheel's travel in the window
