@@ -110,3 +110,21 @@ def test_a_clock_needs_many_runs_that_agree_on_a_real_rate() -> None:
     assert not ClockRate(-600.0, 90.0, 9, 10, 50.0).drifting()  # the runs scatter
     assert not ClockRate(600.0, 30.0, 6, 10, 50.0).drifting()  # too few of the runs
     assert not ClockRate(600.0, 30.0, 3, 3, 50.0).drifting()  # too few runs
+
+
+def test_a_short_latency_no_run_fixes_alone_is_fixed_by_the_session(tmp_path: Path) -> None:
+    """Dev seed 4121 case 34: a LabMate counting 2.8 mm edges on 50 ms ticks whose motion
+    capture runs 7 ms late. Each run's own shift gains less than instrument.LATENCY_DCHI2 over
+    none (its misfit is the counts' coarseness), so every run took none and each turn on the
+    spot left a heading step as strong as the floor's cables; the eight runs' misfits summed
+    fix the clock for all of them."""
+    from odo_tools.gap.diagnose import load
+    from odo_tools.gap.instrument import latency
+
+    real = tmp_path / "real"
+    c = indep_case(4121, 34, real, "labmate", {"bumps": "ramps"})
+    ds = load(real, real / "robot.json", "truth")
+    assert all(latency(pr) is None for pr in ds.prs)
+    true = c["fidelity"]["truth_latency_s"]
+    got = set(ds.instrument.latency_s.values())
+    assert len(got) == 1 and abs(got.pop() - true) < 0.0015, (ds.instrument.latency_s, true)

@@ -371,12 +371,9 @@ def _lever_rounds(ds: Dataset, keys: list[str], nominal_first: bool = False) -> 
             inst.lever_mm[t] = o if instrument.significant(o, se) else (0.0, 0.0)
             if t == 0:  # the latency again, with this lever arm
                 wt = [pr for pr in ds.prs if pr.run.truth is not None]
-                found = {
-                    pr.run.name: instrument.latency(
-                        pr, lever=inst.lever_mm[0], heading_offset=inst.heading_offset_rad[0]
-                    )
-                    for pr in wt
-                }
+                found = instrument.run_latencies(
+                    wt, lever=inst.lever_mm[0], heading_offset=inst.heading_offset_rad[0]
+                )
                 inst.latency_s.update(instrument.session_latencies(wt, found))
             notes.append(
                 f"truck {'AB'[t]}: no turns on the spot: lever arm from {n} windows on arcs, "
