@@ -289,7 +289,8 @@ def _best_shift(chi: np.ndarray) -> int | None:
 
 
 def _refined(chi: np.ndarray, k: int) -> float:
-    """The shift (s) at grid index k, refined on the parabola through the three best."""
+    """The shift (s) at grid index k, refined on the parabola through the three best (of a
+    run's own misfit as it was summed: the same vertex as in noise units, to the last bit)."""
     L = float(LATENCY_GRID[k])
     c0, c1, c2 = chi[k - 1], chi[k], chi[k + 1]
     den = c0 - 2 * c1 + c2
@@ -320,7 +321,7 @@ def latency(
         return None
     if abs(LATENCY_GRID[k]) < min_tick * float(np.median(pr.dt)):
         return 0.0
-    return _refined(chi, k)
+    return _refined(sh.cost, k)
 
 
 def run_latencies(
@@ -346,7 +347,7 @@ def run_latencies(
         chi = sh.cost / sh.noise**2
         k = _best_shift(chi)
         if k is not None:
-            found[pr.run.name] = _refined(chi, k)
+            found[pr.run.name] = _refined(sh.cost, k)
         else:
             pool.setdefault(pr.run.session, []).append((pr.run.name, chi))
     for sess, runs in pool.items():
