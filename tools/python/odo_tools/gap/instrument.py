@@ -333,7 +333,7 @@ def run_latencies(
     """Each run's own latency (`latency`), and where no run of a session fixes one alone, the
     shift their misfits fix together (summed in each run's noise units), given to each: one
     clock for the session. Coarse counts make each run's misfit noisy: a LabMate's 2.8 mm
-    edges on 50 ms ticks left its truth's 7 ms at Delta chi^2 9-16 per run, so none took a
+    edges on 50 ms ticks left its truth's 7 ms at Delta chi^2 2-24 per run, so none took a
     latency, and each turn on the spot left a step in the heading residual as strong as the
     floor's cables, which hid them (independent world, dev seed 4121 case 34, floor bumps:
     "unexplained"); its eight runs together fix 7 ms."""
