@@ -64,6 +64,20 @@ def indep_case(seed: int, k: int, out: Path, vehicle: str, laws: dict) -> dict:
     return c
 
 
+def each_run_its_own_latency(monkeypatch) -> None:
+    """The truth's latency as it was read before the session's runs were summed
+    (instrument.run_latencies): each run's own shift, none where a run fixes none."""
+    from odo_tools.gap import instrument
+
+    def own(prs, P=None, lever=(0.0, 0.0), heading_offset=0.0) -> dict:
+        return {
+            pr.run.name: instrument.latency(pr, 0, P, lever=lever, heading_offset=heading_offset)
+            for pr in prs
+        }
+
+    monkeypatch.setattr(instrument, "run_latencies", own)
+
+
 def indep_named(seed: int, k: int, tmp: Path, vehicle: str, laws: dict, effect: str,
                 law: str, mode: str = "truth") -> tuple[dict, dict]:
     """indep_case k of `seed` diagnosed in `mode`: (the case, the report), after checking that

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from gap_support import indep_case, indep_named
+from gap_support import each_run_its_own_latency, indep_case, indep_named
 from odo_tools.gap import diagnose as D
 from odo_tools.gap import hypotheses
 from odo_tools.gap.fit import Problem
@@ -273,10 +273,12 @@ def test_a_member_the_tracks_do_not_need_leaves_the_pair(tmp_path, monkeypatch) 
     it (Delta qBIC -0.1, accepted on the tracks: 13.1 -> 4.9 x the background). Without the
     slip the tracks stay where they were, so it leaves (diagnose._prune_members) and the
     verdict is the trailer's Ed. Since the clock is scanned where no run fixed one (10 ms
-    found), the trailer's Ed leads alone and nothing needs to leave; the pruning is asked
-    here with the clock left unscanned, as it was, and the track fit off."""
+    found), the trailer's Ed leads alone and nothing needs to leave; and since the runs' misfits
+    are summed where none fixes a latency alone (instrument.run_latencies), they read 6.5 ms
+    before any ranking. The pruning is asked here with each run's own latency and the clock
+    left unscanned, as it was, and the track fit off."""
     real = tmp_path / "real"
-    indep_case(2761, 28, real, "set", {"ed": "fixed"})
+    c = indep_case(2761, 28, real, "set", {"ed": "fixed"})
 
     def diagnosed() -> dict:
         rep = D.diagnose(real, real / "robot.json", mode="truth").to_dict()
@@ -285,8 +287,13 @@ def test_a_member_the_tracks_do_not_need_leaves_the_pair(tmp_path, monkeypatch) 
         return rep
 
     rep = diagnosed()
-    assert set(rep["instrument"]["latency_s"].values()) == {0.01}
+    got = set(rep["instrument"]["latency_s"].values())
+    true = c["fidelity"]["truth_latency_s"]
+    assert len(got) == 1 and abs(got.pop() - true) < 0.0015, (got, true)
     assert "the accumulated track" not in rep["proposals"]
+    each_run_its_own_latency(monkeypatch)
+    rep = diagnosed()
+    assert set(rep["instrument"]["latency_s"].values()) == {0.01}
     ask = D._slip_not_latency
 
     def no_scan(ds, sel, ranked, best, cand=None, others=()) -> bool:
