@@ -20,7 +20,7 @@ FAST_QUANTILE = (
 
 
 ACCEL_MM_S2 = 50.0  # a tick whose smoothed speed changes faster than this is accelerating
-ACCEL_JITTER_MM_S2 = 0.25 * ACCEL_MM_S2  # ... 4 sigma above what whole edges alone make
+ACCEL_JITTER_MM_S2 = 0.25 * ACCEL_MM_S2  # whole edges may scatter it by this (one sigma)
 
 
 def _smoothing_ticks(pr: Prepared) -> int:
@@ -28,8 +28,8 @@ def _smoothing_ticks(pr: Prepared) -> int:
     as keep the scatter that whole edges make within ACCEL_JITTER_MM_S2 (one sigma). Each
     wheel's count is its travel rounded to q mm edges (an error uniform over one edge), so a
     mean of both wheels over m ticks of length T is off by q / (sqrt(6) m T) and the centred
-    difference of two such means, two ticks apart, by sqrt(2/3) q / (4 m T^2): 2 mm/s^2 for
-    the OptiOdom robot's 0.11 mm edges on 50 ms ticks over 0.25 s, but 46 mm/s^2 for a
+    difference of two such means, two ticks apart, by sqrt(2/3) q / (4 m T^2): 1.5 mm/s^2 for
+    the OptiOdom robot's 0.094 mm edges on 50 ms ticks over 0.25 s, but 46 mm/s^2 for a
     LabMate's 2.8 mm edges, and half of every square it drove read as "acceleration"
     (independent world, dev seed 4121 case 34, floor bumps: 69 % of the excess there, which
     proposed slip)."""
