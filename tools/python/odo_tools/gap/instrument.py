@@ -228,6 +228,11 @@ class _Shifts(NamedTuple):
     cost: np.ndarray
     noise: float
 
+    @property
+    def chi(self) -> np.ndarray:
+        """The misfit in units of the noise (what LATENCY_DCHI2 is counted in)."""
+        return self.cost / self.noise**2
+
 
 LATENCY_GRID = np.arange(-LATENCY_MAX_S, LATENCY_MAX_S + 1e-9, LATENCY_STEP_S)
 
@@ -241,7 +246,7 @@ def _shifts(
 ) -> _Shifts | None:
     """The truth's heading (times half the wheelbase) and travel increments over 0.4 s windows
     against the model's (P, nominal by default), summed over the windows, under every shift
-    of LATENCY_GRID; None where fewer than 10 windows are usable."""
+    of LATENCY_GRID; None where fewer than 10 windows are usable or they carry no noise."""
     tr = pr.run.truth
     p = dead_reckon(pr, P or {}, truck)
     tt = tr.t_s
@@ -275,7 +280,8 @@ def _shifts(
         return None
     R = R[:, usable]
     cost = np.sum(R * R, axis=1)
-    return _Shifts(cost, _mad(np.diff(R[int(np.argmin(cost))])) / math.sqrt(2.0))
+    noise = _mad(np.diff(R[int(np.argmin(cost))])) / math.sqrt(2.0)
+    return _Shifts(cost, noise) if noise > 0 else None
 
 
 def _best_shift(chi: np.ndarray) -> int | None:
@@ -313,10 +319,7 @@ def latency(
     accumulated track: a strong effect (a scrub, slip) leaves a track misfit that a time shift
     of 0.2 s lowers too (tried: the blind check's simulator, which has no latency, read 0.2 s)."""
     sh = _shifts(pr, truck, P, lever, heading_offset)
-    if sh is None or not sh.noise > 0:
-        return None
-    chi = sh.cost / sh.noise**2
-    k = _best_shift(chi)
+    k = None if sh is None else _best_shift(sh.chi)
     if k is None:
         return None
     if abs(LATENCY_GRID[k]) < min_tick * float(np.median(pr.dt)):
@@ -343,15 +346,14 @@ def run_latencies(
     for pr in prs:
         sh = _shifts(pr, 0, P, lever, heading_offset)
         found[pr.run.name] = None
-        if sh is None or not sh.noise > 0:
+        if sh is None:
             continue
-        chi = sh.cost / sh.noise**2
-        k = _best_shift(chi)
+        k = _best_shift(sh.chi)
         if k is not None:
             found[pr.run.name] = _refined(sh.cost, k)
-        elif 0 < int(np.argmin(chi)) < LATENCY_GRID.size - 1:
+        elif 0 < int(np.argmin(sh.chi)) < LATENCY_GRID.size - 1:
             # a run whose least misfit lies on the grid's edge (a spin) says nothing of a clock
-            pool.setdefault(pr.run.session, []).append((pr.run.name, chi))
+            pool.setdefault(pr.run.session, []).append((pr.run.name, sh.chi))
     for sess, runs in pool.items():
         if any(found[pr.run.name] is not None for pr in prs if pr.run.session == sess):
             continue
