@@ -385,6 +385,21 @@ def test_bumps_the_tracks_want_replace_a_best_that_leaves_them(tmp_path: Path) -
     assert left and float(left.group(1)) < 3.5, said  # the tracks: 36 x nominally
 
 
+def test_bumps_meet_the_geometry_the_tracks_chose_by_the_same_rule(tmp_path: Path) -> None:
+    """Independent world, dev seed 4202 case 35: a LabMate's squares cross two cables (7.6 mm
+    steps) on a floor of nothing else. No single beats the nominal model on the windows, the
+    fitting runs' tracks sit at 4.9 x the background, and the geometry fitted to them chose an
+    Ed that left 2.38 x (diagnose._track_refit); the bumps, which leave the tracks at 1.15 x,
+    were never asked, and the held-out runs stayed at 3.05 x ("unexplained"). The bumps meet
+    the tracks' geometry by the rule they meet the windows' best (diagnose._bumps_on_tracks)."""
+    _, rep = indep_named(4202, 35, tmp_path, "labmate", {"bumps": "steps"}, "bumps", "catalog")
+    hd = rep["heldout"]
+    assert hd["ratio_after"] < 0.35 * hd["ratio_before"], hd  # Ed: 4.71 -> 3.05 x
+    said = rep["proposals"]["the accumulated track"]
+    geo = re.search(r"tracks leaves ([0-9.]+) x; the floor bumps leave ([0-9.]+) x", said)
+    assert geo and float(geo.group(2)) ** 2 - 1 <= 0.5 * (float(geo.group(1)) ** 2 - 1), said
+
+
 def test_bumps_join_a_best_that_leaves_the_tracks_beyond_three_backgrounds(tmp_path: Path) -> None:
     """Independent world, dev seed 2604 case 5: a clapper over ramps of 17-18 mm, with a scrub
     on truck B. The bumps single ranks far below the scrub, so no pair holds both, and "scrub"
@@ -481,6 +496,38 @@ def test_bumps_replace_the_best_only_where_they_halve_what_the_tracks_keep(
     assert diagnose._bumps_on_tracks(SimpleNamespace(mode="truth"), None, rk) is taken
     assert (rk.best is single) is taken
     assert ("the accumulated track" in rk.proposals) is taken
+
+
+@pytest.mark.parametrize(("bumps", "taken"), [(1.15, True), (2.0, False)])
+def test_bumps_after_the_tracks_refit_weigh_its_geometry_and_add_to_its_reason(
+    monkeypatch: pytest.MonkeyPatch, bumps: float, taken: bool
+) -> None:
+    """After diagnose._track_refit the best is the geometry the tracks chose; the bumps single
+    replaces it where it halves what that geometry leaves (dev seed 4202 case 35: nominal 4.94,
+    the tracks' Ed 2.38, the bumps 1.15), and the tracks' reason keeps the geometry's figure."""
+    from odo_tools.gap import diagnose
+    from odo_tools.gap.hypotheses import Hypothesis, catalog_law
+
+    def fit(name: str, fam: str | None, floor: list) -> SimpleNamespace:
+        hyp = Hypothesis((catalog_law(fam, "labmate"),)) if fam else None
+        return SimpleNamespace(name=name, hyp=hyp, bumps=floor)
+
+    ratios = {"nominal": 4.94, "ed": 2.38, "bumps": bumps}
+    monkeypatch.setattr(diagnose, "_track_ratio", lambda f, *_: ratios[f.name])
+    single = fit("bumps", "bumps", [_bump("cw:1", ["run-cw-01"], 1000.0, 0.0)])
+    said = "the fitting runs' tracks sit at 4.9 x ...; ed fitted to the tracks leaves 2.38 x"
+    rk = SimpleNamespace(
+        null=fit("nominal", None, []),
+        best=fit("ed", "ed", []),
+        singles=[single],
+        proposals={"the accumulated track": said},
+        prob=None,
+        bumps_other=None,
+    )
+    assert diagnose._bumps_on_tracks(SimpleNamespace(mode="truth"), None, rk, None, True) is taken
+    assert (rk.best is single) is taken
+    got = rk.proposals["the accumulated track"]
+    assert got == (said + "; the floor bumps leave 1.15 x" if taken else said)
 
 
 @pytest.mark.parametrize(("other_ratio", "named"), [(1.48, "other"), (3.6, None), (3.2, "single")])
