@@ -386,12 +386,13 @@ def test_bumps_the_tracks_want_replace_a_best_that_leaves_them(tmp_path: Path) -
 
 
 def test_bumps_meet_the_geometry_the_tracks_chose_by_the_same_rule(tmp_path: Path) -> None:
-    """Independent world, dev seed 4202 case 35: a LabMate's squares cross two cables (7.6 mm
-    steps) on a floor of nothing else. No single beats the nominal model on the windows, the
-    fitting runs' tracks sit at 4.9 x the background, and the geometry fitted to them chose an
-    Ed that left 2.38 x (diagnose._track_refit); the bumps, which leave the tracks at 1.15 x,
-    were never asked, and the held-out runs stayed at 3.05 x ("unexplained"). The bumps meet
-    the tracks' geometry by the rule they meet the windows' best (diagnose._bumps_on_tracks)."""
+    """Independent world, dev seed 4202 case 35: a LabMate's squares cross three cables (steps
+    of about 7.6 mm) on a floor of nothing else. No single beats the nominal model on the
+    windows, the fitting runs' tracks sit at 4.9 x the background, and the geometry fitted to
+    them chose an Ed that left 2.38 x (diagnose._track_refit); the bumps, which leave the
+    tracks at 1.15 x, were never asked, and the held-out runs stayed at 3.05 x ("unexplained").
+    The bumps meet the tracks' geometry by the rule they meet the windows' best
+    (diagnose._bumps_on_tracks)."""
     _, rep = indep_named(4202, 35, tmp_path, "labmate", {"bumps": "steps"}, "bumps", "catalog")
     hd = rep["heldout"]
     assert hd["ratio_after"] < 0.35 * hd["ratio_before"], hd  # Ed: 4.71 -> 3.05 x
