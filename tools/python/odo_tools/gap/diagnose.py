@@ -9,8 +9,9 @@ Three steps, each its own function:
    laws of the families the residual points to (hypotheses.propose), pairs and a third member
    where they pay for themselves; evidence is BIC, pairs by quasi-BIC. In truth mode the
    robot's geometry is then fitted to the fitting runs' accumulated tracks where the windows'
-   best leaves them far from the background (`_track_refit`), or joined to a best that has no
-   geometry (`_geometry_beside`).
+   best leaves them far from the background (`_track_refit`), floor bumps are weighed on the
+   same tracks against whichever best that leaves (`_bumps_on_tracks`), and geometry or bumps
+   join a best that has none (`_geometry_beside`, `_bumps_beside`).
 3. `judge` on the held-out runs (select.py chooses them): the measured background
    (background.py), the best candidate's held-out gap against it (heldout.py), the verdict
    (`decide`), and the parameters' stability across groups (stability.py).
