@@ -441,3 +441,50 @@ def test_a_spare_member_whose_removal_mends_the_tracks_leaves_whatever_the_windo
     pair = _fit("skid", "slip", dev=5870.0)
     got, r = D._drop_members(pair, 8.2, lambda h, cur: alone[h.name])
     assert (got.name, r) == ("skid", 1.34)
+
+
+def test_a_scrub_no_held_out_run_shows_is_judged_path_by_path(tmp_path: Path) -> None:
+    """Independent world, dev seed 4220 case 37: a LabMate's torque scrub changes no spot turn;
+    its circle and free drive were fitted, two squares and a shuttle judged, and the held-out
+    runs sat at 0.68 x the background while the fitting runs' tracks sat at 14.6 x ("no
+    significant gap"). Each fitting path left out of the scrub's fit shows it
+    (diagnose._paths_left_out), and the verdict names it with the held-out figure unchanged."""
+    c, rep = indep_named(4220, 37, tmp_path, "labmate", {"scrub": "torque"}, "scrub", "catalog")
+    hd = rep["heldout"]
+    assert hd["ratio_before"] < D.R_GAP, hd  # the held-out runs still show no gap
+    said = rep["verdict"]["reason"]
+    assert "path by path" in said, said
+    k = rep["verdict"]["params"]["scrub.k"]
+    assert 0.0 < k < 2.0 * c["true"]["effects"]["scrub"]["s_sat"], (k, c["true"]["effects"])
+
+
+@pytest.mark.parametrize(
+    ("fams", "paths", "r0", "r1", "named"),
+    [
+        (("scrub",), 5, 14.6, 1.27, True),  # dev 4220 case 37
+        (("scrub",), 5, 14.6, 2.5, True),  # 2.5 x still removes 97 % of 14.6 x's excess
+        (("scrub",), 5, 3.0, 2.5, False),  # a gap the paths left out keep
+        (("scrub",), 5, 1.9, 1.0, False),  # the fitting tracks show no gap either
+        (("scrub",), 1, 14.6, 1.0, False),  # one path: nothing left out
+        (("slip",), 5, 14.6, 1.0, False),  # no geometry: the tracks cannot fit it
+    ],
+)
+def test_the_fitting_paths_judge_only_a_gap_they_show_and_close_left_out(
+    monkeypatch: pytest.MonkeyPatch, fams: tuple, paths: int, r0: float, r1: float, named: bool
+) -> None:
+    """The rule of diagnose._paths_left_out on the fitting runs' nominal track ratio (r0) and the
+    best's ratio on each path left out of its fit (r1, `_track_cv`)."""
+    from types import SimpleNamespace
+
+    hyp = hypotheses.Hypothesis(tuple(hypotheses.catalog_law(f, "labmate") for f in fams))
+    best = SimpleNamespace(hyp=hyp, label="+".join(fams), model_params=dict)
+    items = [SimpleNamespace(pr=SimpleNamespace(path=f"p{i % paths}")) for i in range(6)]
+    tp = SimpleNamespace(items=items, ratio=lambda P: r0)
+    monkeypatch.setattr(D, "_fitting_tracks", lambda *a: tp)
+    monkeypatch.setattr(D, "group_key", lambda pr: pr.path)
+    monkeypatch.setattr(D, "_track_cv", lambda *a, **k: r1 * r1)
+    held = SimpleNamespace(ratio_before=0.7)
+    got = D._paths_left_out(None, None, SimpleNamespace(best=best, prob=None), held)
+    assert (got is not None) is named
+    if named:
+        assert got[0] == best.label and "path by path" in got[1]
