@@ -295,6 +295,7 @@ class Report:
             {"what": k, "why": v}
             for k, v in catalog.not_identifiable(ds.mode, ds.robot.vehicle).items()
         ]
+        unident += [{"what": WORDS.get(k, k), "why": v} for k, v in rk.unseen.items()]
         for k, se in best.stderr.items():
             v = best.params.get(k, 0.0)
             ref = abs(v - 1.0) if k.endswith(".value") else abs(v)
