@@ -5,7 +5,8 @@ Three steps, each its own function:
 1. `load`: runs of one or more folders (one recording session each) against one robot
    description, the evidence mode, the truth's instrument nuisances (lever arm, latency), the
    per-run evidence objects (modes.EvidenceMode).
-2. `rank` on the fitting runs: every hypothesis the mode sees (hypotheses.singles), the other
+2. `rank` on the fitting runs: every hypothesis the mode sees (hypotheses.singles) and the
+   fitting runs can show (`unseen`: a scrub needs arcs), the other
    laws of the families the residual points to (hypotheses.propose), pairs and a third member
    where they pay for themselves; evidence is BIC, pairs by quasi-BIC. In truth mode the
    robot's geometry is then fitted to the fitting runs' accumulated tracks where the windows'
