@@ -7,6 +7,7 @@ in that noise; along a square it leaves ~8 mm against a ~1 mm background."""
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import numpy as np
@@ -466,7 +467,10 @@ def test_a_scrub_no_held_out_run_shows_is_judged_path_by_path(tmp_path: Path) ->
         (("scrub",), 5, 3.0, 2.5, False),  # a gap the paths left out keep
         (("scrub",), 5, 1.9, 1.0, False),  # the fitting tracks show no gap either
         (("scrub",), 1, 14.6, 1.0, False),  # one path: nothing left out
-        (("slip",), 5, 14.6, 1.0, False),  # no geometry: the tracks cannot fit it
+        (("slip",), 5, 14.6, 1.27, True),  # any law the tracks fit (seed 3341 case 3)
+        (("slip",), 5, 3.0, 2.5, False),
+        (("bumps",), 5, 14.6, 1.0, False),  # placed only where two fitting runs agree
+        (("link_bias",), 5, 14.6, 1.0, False),  # a linkage bias: the tracks do not see it
     ],
 )
 def test_the_fitting_paths_judge_only_a_gap_they_show_and_close_left_out(
@@ -488,3 +492,16 @@ def test_the_fitting_paths_judge_only_a_gap_they_show_and_close_left_out(
     assert (got is not None) is named
     if named:
         assert got[0] == best.label and "path by path" in got[1]
+
+
+def test_a_skid_no_held_out_run_shows_is_judged_path_by_path(tmp_path: Path) -> None:
+    """Independent world, dev seed 4121 case 33: a LabMate's cornering skid; its held-out runs
+    sit at 0.51 x the background, its fitting runs' tracks at 5.0 x. Judged path by path as a
+    scrub is (any law the tracks can be fitted under, not geometry alone): "no significant gap"
+    on the code before, the skid now, its stiffness within 10 % of the world's."""
+    c, rep = indep_named(4121, 33, tmp_path, "labmate", {"skid": "cornering"}, "skid", "cornering")
+    assert rep["heldout"]["ratio_before"] < D.R_GAP, rep["heldout"]
+    assert "path by path" in rep["verdict"]["reason"], rep["verdict"]["reason"]
+    want = math.degrees(1.0 / c["true"]["effects"]["skid"]["c_alpha_m_s2"])  # deg per m/s^2
+    got = rep["verdict"]["params"]["skid@cornering.deg_per_m_s2"]
+    assert got == pytest.approx(want, rel=0.1), (got, want)
