@@ -72,7 +72,15 @@ from .report import Context, Report
 from .select import Selection, explicit, parse_groups, stratified
 from .stability import analyse as stability
 from .stability import drift
-from .verdict import EXCESS_REMOVED, R_GAP, R_WITHIN, decide, weak_zone
+from .verdict import (
+    EXCESS_REMOVED,
+    R_GAP,
+    R_WITHIN,
+    closes,
+    decide,
+    removed_share,
+    weak_zone,
+)
 from .where import phase_excess, truck_excess, where_analysis
 
 Progress = Callable[[str], None] | None
@@ -968,6 +976,13 @@ def _track_simplest(fits: list[Fit], ratios: list[float]) -> tuple[Fit, float]:
     return fits[b], ratios[b]
 
 
+def _track_families(ds: Dataset, rk: Ranking) -> list[str]:
+    """The geometry the tracks are fitted under: TRACK_FAMILIES the catalog has for the robot
+    and the fitting runs can show (`unseen`)."""
+    cat = catalog.hypotheses("truth", ds.robot.vehicle)
+    return [f for f in TRACK_FAMILIES if f in cat and f not in rk.unseen]
+
+
 def _track_refit(ds: Dataset, sel: Selection, rk: Ranking, progress: Progress = None) -> bool:
     """Truth mode: where the fitting runs' tracks show a gap (R >= R_GAP nominal) that the
     windows' best leaves (R > R_WITHIN), the geometry effects are fitted to the tracks (each
@@ -1002,11 +1017,7 @@ def _track_refit(ds: Dataset, sel: Selection, rk: Ranking, progress: Progress = 
         # Ed of 1.00003 took a set's tracks from 2.2 to 1.7 x beside its rotary bias, and the
         # held-out runs not at all (2681 case 33; 3071 case 54's sit at 34 x)
         return False
-    fams = [
-        f
-        for f in TRACK_FAMILIES
-        if f in catalog.hypotheses("truth", ds.robot.vehicle) and f not in rk.unseen
-    ]
+    fams = _track_families(ds, rk)
     laws = {f: hypotheses.catalog_law(f, ds.robot.vehicle) for f in fams}
     warm = {}
     for f in rk.singles:
@@ -1088,11 +1099,7 @@ def _geometry_beside(ds: Dataset, sel: Selection, rk: Ranking, progress: Progres
     case 40, traced after that seed was measured)."""
     if ds.mode != "truth" or rk.best.hyp is None or rk.best.hyp.has_bumps:
         return False
-    fams = [
-        f
-        for f in TRACK_FAMILIES
-        if f in catalog.hypotheses("truth", ds.robot.vehicle) and f not in rk.unseen
-    ]
+    fams = _track_families(ds, rk)
     if set(rk.best.hyp.families) & set(fams) or len(rk.best.hyp.laws) >= len(THIRDS):
         return False
     rb = _track_ratio(rk.best, rk.prob, ds, sel)
@@ -1570,9 +1577,9 @@ def _paths_left_out(
     if r0 < R_GAP:
         return None
     r1 = math.sqrt(_track_cv(best.hyp, tp, rk.prob, best.model_params()))
-    removed = 1.0 - (r1 * r1 - 1.0) / (r0 * r0 - 1.0)
-    if r1 > R_WITHIN and removed < EXCESS_REMOVED:
+    if not closes(r0, r1):
         return None
+    removed = removed_share(r0, r1)
     label = best.label
     return label, (
         f"the held-out runs show no gap ({held.ratio_before:.2f} x the background), the fitting "

@@ -68,6 +68,18 @@ def weak_zone(held: HeldOut) -> bool:
     return R_GAP_WEAK <= held.ratio_before < r_gap(held) == R_GAP
 
 
+def removed_share(r0: float, r1: float) -> float:
+    """The share of the misfit above the background (R^2 - 1) that brings R from r0 to r1."""
+    excess0 = r0 * r0 - 1.0
+    return 1.0 - (r1 * r1 - 1.0) / excess0 if excess0 > 0 else 0.0
+
+
+def closes(r0: float, r1: float) -> bool:
+    """The held-out rule: a candidate that brings R from r0 to r1 is named when it leaves R
+    within R_WITHIN or removes at least EXCESS_REMOVED of the misfit above the background."""
+    return r1 <= R_WITHIN or removed_share(r0, r1) >= EXCESS_REMOVED
+
+
 def decide(
     held: HeldOut,
     dbic: float,
@@ -80,8 +92,7 @@ def decide(
     a candidate closes it, "unexplained" when the fitting runs' nominal tracks (`fit_track`,
     in units of the background) show it too and none does."""
     r0, r1 = held.ratio_before, held.ratio_after
-    excess0, excess1 = r0 * r0 - 1.0, r1 * r1 - 1.0
-    removed = 1.0 - excess1 / excess0 if excess0 > 0 else 0.0
+    removed = removed_share(r0, r1)
     rg = r_gap(held)
     tracks_see = fit_track is not None and fit_track >= R_GAP_WEAK
     if (
@@ -126,7 +137,7 @@ def decide(
             f"the nominal model's held-out misfit is {r0:.2f} x the background (a gap needs "
             f"{R_GAP:g} x{weak})"
         )
-    if r1 <= R_WITHIN or removed >= EXCESS_REMOVED:
+    if closes(r0, r1):
         return label, (
             f"{label} brings the held-out misfit from {r0:.2f} to {r1:.2f} x the background "
             f"(named at <= {R_WITHIN:g} x, or when it removes >= {EXCESS_REMOVED:.0%} of the "
