@@ -107,3 +107,48 @@ def test_roughness_counts_in_returns_mode_only_where_the_recording_states_its_ac
     assert scored_in({**c, "effects": ["eb"]}, "returns")
     keys = sorted((blind / "sim" / "keys").glob("case-*.json"))
     assert keys and all(json.loads(k.read_text())["accuracy_stated"] for k in keys)
+
+
+def test_the_case_table_marks_what_the_scores_count_wrong(blind: Path) -> None:
+    """cases.md has a row per case, and its misses per mode are the cases the scores count
+    wrong: top-1 misses, false alarms and out-of-catalog cases not called "unexplained"."""
+    s = json.loads((blind / "sim" / "scores.json").read_text())
+    rows = [ln.split(" | ") for ln in (blind / "sim" / "cases.md").read_text().splitlines()
+            if ln.startswith("| ") and ln[2].isdigit()]
+    assert [int(r[0][2:]) for r in rows] == list(range(8))
+    for col, m, top1 in ((4, "truth", "top1_accuracy"), (5, "returns",
+                                                         "top1_accuracy_return_errors")):
+        n = {"truth": "top1_cases", "returns": "top1_return_errors_cases"}[m]
+
+        def wrong(rate: float, cases: int) -> int:
+            return round((1 - rate) * cases) if cases else 0
+
+        want = (wrong(s[top1], s[n])
+                + round(s["false_alarm_rate_by_mode"][m] * s["no_effect_cases_by_mode"][m])
+                + wrong(s["unexplained_rate_out_of_catalog_by_mode"][m],
+                        sum(1 for r in rows if r[3] == "unexplained"
+                            and "(not scored)" not in r[col])))
+        assert sum("**miss**" in r[col] for r in rows) == want, m
+
+
+def test_the_case_table_marks_a_miss_only_where_the_case_counts() -> None:
+    from odo_tools.validation.blind import cases_md
+
+    def res(k: int, mode: str, verdict: str) -> dict:
+        return {"real": f"/d/case-{k:03d}/real", "mode": mode,
+                "report": {"verdict": {"effect": verdict}}}
+
+    cases = [{"case": 0, "vehicle": "labmate", "kind": "single", "effects": ["ed"],
+              "laws": {"ed": "speed"}},
+             {"case": 1, "vehicle": "labmate", "kind": "none", "effects": []},
+             {"case": 2, "vehicle": "labmate", "kind": "single", "effects": ["roughness"]}]
+    results = [res(0, "truth", "ed"), res(0, "returns", "eb"), res(1, "truth", "ed"),
+               res(1, "returns", "no significant gap"), res(2, "returns", "eb"),
+               {"real": "/d/case-002/real", "mode": "truth", "error": "refused"}]
+    md = cases_md(cases, results, "independent", 7)
+    assert "--seed 7 --case K" in md
+    rows = {ln.split(" | ")[0][2:]: ln for ln in md.splitlines() if ln[:3] in ("| 0", "| 1", "| 2")}
+    assert rows["0"].endswith("| ed (speed) | ed | ed | eb **miss** |  |")
+    assert rows["1"].endswith("| none | no significant gap | ed **miss** | no significant gap |  |")
+    # roughness from returns without a stated accuracy is not scored; a refused case is a miss
+    assert rows["2"].endswith("| roughness | error **miss** | eb (not scored) |  |")

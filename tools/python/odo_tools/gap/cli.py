@@ -134,7 +134,8 @@ def main(argv: list[str] | None = None) -> int:
         "--out",
         required=True,
         help="new folder: per world keys/, results.json, scores.json (every figure, and "
-        "visible_only: the same over the cases whose effect leaves an imprint), scores.png",
+        "visible_only: the same over the cases whose effect leaves an imprint), scores.png, "
+        "cases.md (each case's withheld truth beside every mode's verdict, misses marked)",
     )
     b.add_argument(
         "--force",

@@ -396,9 +396,9 @@ def run_blind(
     force: bool = False,
 ) -> dict:
     """Generate, diagnose and score `n_cases` per world. OUT/<world>/{keys/, scores.json,
-    results.json, scores.png}, OUT/scores.json with every world. The whole of OUT (keys included)
-    is built in the output rule's fresh temp folder (odo_tools/outpath.py), which the diagnosing
-    workers may not open, and moved into place by that rule."""
+    results.json, scores.png, cases.md}, OUT/scores.json with every world. The whole of OUT
+    (keys included) is built in the output rule's fresh temp folder (odo_tools/outpath.py),
+    which the diagnosing workers may not open, and moved into place by that rule."""
     t0 = time.perf_counter()
     try:
         od = OutDir(out, BLIND_TOOL, force)
@@ -443,6 +443,7 @@ def run_blind(
                 json.dumps([_summ(r) for r in results], indent=1) + "\n"
             )
             plot_scores(scores, tmp / w / "scores.png")
+            (tmp / w / "cases.md").write_text(cases_md(cases, results, w, seed))
             all_scores[w] = scores
             if progress:
                 progress(f"{w}: " + json.dumps(headline(scores)))
@@ -574,15 +575,72 @@ def seen_in(c: dict, mode: str) -> bool | None:
     return None if im is None else bool(im["visible"])
 
 
+def pred_of(r: dict | None) -> str | None:
+    """A diagnosis' verdict as scored (pairs in any order), "error" for a refused case."""
+    if r is None:
+        return None
+    return norm(r["report"]["verdict"]["effect"]) if "report" in r else "error"
+
+
+def counts_toward(c: dict, mode: str) -> str | None:
+    """Which of a mode's figures a case counts toward (`score`): "top-1" (a catalog case the
+    mode identifies), "false alarm" (no effect), "unexplained" (out of the catalog, acting where
+    the mode looks), or None (a case the mode is not scored on)."""
+    if scored_in(c, mode):
+        return "top-1"
+    if c["kind"] == "none":
+        return "false alarm"
+    if c["kind"] == "ooc" and reaches(c, mode):
+        return "unexplained"
+    return None
+
+
+def cases_md(cases: list[dict], results: list[dict], world_name: str, seed: int) -> str:
+    """Every case with its withheld truth and each mode's verdict, a miss marked where the case
+    counts toward that mode's figures (`counts_toward`): the list a developer traces misses from
+    (on dev seeds; never tune on the seeds reported)."""
+    byreal = {(Path(r["real"]).parent.name, r["mode"]): r for r in results}
+    head = [
+        f"# odo-gap blind: {world_name} world, seed {seed}, {len(cases)} cases",
+        "",
+        "Verdict per evidence mode; **miss** where the case counts toward that mode's top-1, "
+        "false-alarm or out-of-catalog figure and the verdict is not its truth; (not scored) "
+        "where the mode is not judged on it (README, section Sim-to-real gap). Keys: keys/.",
+    ]
+    if world_name == "independent":
+        head += [
+            "",
+            "One case by hand, its data byte for byte as diagnosed here: `python -m "
+            f"odo_tools.validation.indep --seed {seed} --case K --out DIR/real --key "
+            "DIR/key.json`, "
+            "then `odo-gap diagnose --real DIR/real --robot DIR/real/robot.json --mode MODE`.",
+        ]
+    modes = ("truth", "returns", "linkage")
+    rows = ["", "| case | vehicle | withheld (law) | right verdict | " + " | ".join(modes) + " |",
+            "|---|---|---|---|" + "---|" * len(modes)]
+    for c in cases:
+        name = f"case-{c['case']:03d}"
+        laws = c.get("laws") or {}
+        drawn = " + ".join(f"{e} ({laws[e]})" if e in laws else e for e in c.get("effects", []))
+        want = truth_label(c)
+        cells = []
+        for m in modes:
+            got = pred_of(byreal.get((name, m)))
+            if got is None:
+                cells.append("")
+                continue
+            fig = counts_toward(c, m)
+            mark = "(not scored)" if fig is None else ("" if got == want else "**miss**")
+            cells.append(f"{got} {mark}".strip())
+        rows.append(f"| {c['case']} | {c['vehicle']} | {drawn or 'none'} | {want} | "
+                    + " | ".join(cells) + " |")
+    return "\n".join(head + rows) + "\n"
+
+
 def score(cases: list[dict], results: list[dict]) -> dict:
     byreal = {}
     for r in results:
         byreal[(Path(r["real"]).parent.name, r["mode"])] = r
-
-    def pred_of(r: dict | None) -> str | None:
-        if r is None:
-            return None
-        return norm(r["report"]["verdict"]["effect"]) if "report" in r else "error"
 
     rate = lambda k, n: (k / n if n else float("nan"), n)  # noqa: E731
     per_mode, fa_mode, un_mode, vis_mode = {}, {}, {}, {}
@@ -594,8 +652,9 @@ def score(cases: list[dict], results: list[dict]) -> dict:
             pred = pred_of(byreal.get((f"case-{c['case']:03d}", m)))
             if pred is None:
                 continue
-            scored = scored_in(c, m)
-            ooc = c["kind"] == "ooc" and reaches(c, m)
+            fig = counts_toward(c, m)
+            scored = fig == "top-1"
+            ooc = fig == "unexplained"
             if scored:
                 tot += 1
                 ok += pred == truth_label(c)
