@@ -44,6 +44,7 @@ EXTRA_BOUNDS = {
     "count_loss@plateau.excess_mm_s": (0.0, 5000.0, 400.0),
     "count_loss@plateau.a_m_s2": (0.05, 20.0, 1.0),
     "count_loss@flagged.counts": (0.0, 1000.0, 2.0),
+    "count_loss@missed.scale": (0.05, 20.0, 1.0),
     "skid@cornering.deg_per_m_s2": (0.0, 30.0, 1.0),
     "skid@friction.a_lim_m_s2": (0.05, 20.0, 2.0),
     "eb@load.zeta": (0.0, 1.0, 0.05),
@@ -169,6 +170,15 @@ OTHER_LAWS = {
             ("count_loss@flagged.counts",),
             "the decoder's own word: a wheel tick flagged with a skipped quadrature state "
             "(WHEEL_COUNTS Status) lost this many counts",
+        ),
+        Law(
+            "count_loss",
+            "missed",
+            ("count_loss@missed.scale",),
+            "edges missed with a probability that rises with the edge rate and saturates, read "
+            "from how often the decoders flagged a tick at each rate (model.read_missed); a "
+            "flagged tick lost the two counts of each state it skipped; scale sets where the "
+            "probability saturates (scale x the flags' p_max), the low-rate tail kept",
         ),
     ),
     "rotary_bias": (
@@ -357,7 +367,7 @@ def unproposed(h: Hypothesis, proposals: dict) -> bool:
 
 # laws that act only on ticks the wheel decoders flagged (model.count_loss_flagged): nothing to
 # fit where they flagged none
-NEEDS_FLAGS = ("count_loss@flagged",)
+NEEDS_FLAGS = ("count_loss@flagged", "count_loss@missed")
 
 
 def tried_laws(proposals: dict, mode: str, vehicle: str, flagged: bool = False) -> list[Hypothesis]:

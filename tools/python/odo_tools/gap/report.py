@@ -49,6 +49,9 @@ LAW_WORDS = {
     "growth": "one tyre's rolling radius grows with the square of its speed, beside a fixed Ed",
     "flagged": "the wheel decoders' own word: each wheel tick they flagged with a skipped "
     "quadrature state lost this many counts (one skipped state: 2)",
+    "missed": "edges missed with a probability that rises with the edge rate and saturates, as "
+    "often as the decoders' flags show at each rate; a flagged tick lost two counts per state "
+    "it skipped (scale: where the probability saturates, x the flags' own reading)",
     "plateau": "a count-rate ceiling: the counts sit on a flat top while the hidden wheel speed "
     "rises beyond it and back",
     "cornering": "linear cornering stiffness: the tyres run at a slip angle proportional to the "
