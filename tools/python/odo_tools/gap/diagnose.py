@@ -169,7 +169,8 @@ def load(
     for i in range(0, len(halved), 2):  # the halves of a run: one path, split together
         prs[halved[i + 1]].path = prs[halved[i]].path
     assign_shapes(prs)
-    read_missed(prs)
+    if "count_loss" in catalog.hypotheses(mode, robot.vehicle):
+        read_missed(prs)
     ds = Dataset(robot, str(robot_path), folders, runs, prs, [], mode, groups, return_accuracy)
     ds.halved = [runs[i].name.removesuffix("-h1") for i in halved[::2]]
     try:
@@ -1043,7 +1044,7 @@ def _track_refit(ds: Dataset, sel: Selection, rk: Ranking, progress: Progress = 
     # do (independent world, dev seed 4501 case 12: 9.0 x nominally, a scrub 1.17 x, the
     # missed-edge law 0.89 x); the speed law among them, where the windows chose it and the
     # flags saturate (4510 case 41, 100 ms ticks)
-    if any(ds.prs[i].flagged is not None and ds.prs[i].flagged.any() for i in sel.fit):
+    if skipped_evidence([ds.prs[i] for i in sel.fit]) is not None:
         singles += hypotheses.other_laws("count_loss", "truth", ds.robot.vehicle)
     singles = _on_excess_truck(singles, tp, {}, ds)
     fits = par.each(

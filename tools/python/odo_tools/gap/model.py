@@ -523,10 +523,11 @@ MISS_MIN_FLAGS = 20  # flagged wheel ticks a truck needs for its missed-edge cur
 def _edge_rates(prs: list, truck: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Every wheel tick of a truck's decoders over the runs: counted edges, edge rate (1/s) and
     whether the decoder flagged a skipped state."""
-    n = [np.abs(pr.ds[:, truck, :]).ravel() / pr.count_mm[truck] for pr in prs]
-    r = [(np.abs(pr.ds[:, truck, :]) / pr.dt[:, None]).ravel() / pr.count_mm[truck] for pr in prs]
+    n = [np.abs(pr.ds[:, truck, :]) / pr.count_mm[truck] for pr in prs]
+    r = [k / pr.dt[:, None] for k, pr in zip(n, prs, strict=True)]
     f = [pr.flagged[:, truck, :].ravel() for pr in prs]
-    return np.concatenate(n), np.concatenate(r), np.concatenate(f)
+    return (np.concatenate([k.ravel() for k in n]), np.concatenate([k.ravel() for k in r]),
+            np.concatenate(f))
 
 
 def _missed_lambda(n, rate, curve: tuple, scale: float = 1.0) -> np.ndarray:

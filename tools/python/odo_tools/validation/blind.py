@@ -575,6 +575,11 @@ def seen_in(c: dict, mode: str) -> bool | None:
     return None if im is None else bool(im["visible"])
 
 
+def by_case(results: list[dict]) -> dict[tuple[str, str], dict]:
+    """The diagnoses by (case folder, mode)."""
+    return {(Path(r["real"]).parent.name, r["mode"]): r for r in results}
+
+
 def pred_of(r: dict | None) -> str | None:
     """A diagnosis' verdict as scored (pairs in any order), "error" for a refused case."""
     if r is None:
@@ -599,7 +604,7 @@ def cases_md(cases: list[dict], results: list[dict], world_name: str, seed: int)
     """Every case with its withheld truth and each mode's verdict, a miss marked where the case
     counts toward that mode's figures (`counts_toward`): the list a developer traces misses from
     (on dev seeds; never tune on the seeds reported)."""
-    byreal = {(Path(r["real"]).parent.name, r["mode"]): r for r in results}
+    byreal = by_case(results)
     head = [
         f"# odo-gap blind: {world_name} world, seed {seed}, {len(cases)} cases",
         "",
@@ -638,9 +643,7 @@ def cases_md(cases: list[dict], results: list[dict], world_name: str, seed: int)
 
 
 def score(cases: list[dict], results: list[dict]) -> dict:
-    byreal = {}
-    for r in results:
-        byreal[(Path(r["real"]).parent.name, r["mode"])] = r
+    byreal = by_case(results)
 
     rate = lambda k, n: (k / n if n else float("nan"), n)  # noqa: E731
     per_mode, fa_mode, un_mode, vis_mode = {}, {}, {}, {}
