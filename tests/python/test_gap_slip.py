@@ -301,7 +301,7 @@ def test_accel_slip_is_named_from_return_errors(tmp_path: Path) -> None:
 
 def test_a_slip_the_windows_cannot_size_is_fitted_on_the_tracks(tmp_path: Path) -> None:
     """Independent world, dev seed 4501 case 9: a LabMate whose tyres slip k 0.031 at 1 m/s^2
-    (power 1.57, the right one 1.7 x the left) under a motion capture whose heading is noisy
+    (power 1.57, the left one 1.7 x the right) under a motion capture whose heading is noisy
     (0.26 deg). The windows' best was a slip, below the nominal by BIC; the tracks, to which
     only geometry was fitted, stayed at 2.5 x the background, and the held-out runs at 2.84 x
     whatever was fitted: "unexplained". The slip's laws fitted to the accumulated tracks take
