@@ -520,13 +520,18 @@ def count_loss_flagged(pr: Prepared, ds: np.ndarray, truck: int, counts: float) 
 MISS_MIN_FLAGS = 20  # flagged wheel ticks a truck needs for its missed-edge curve
 
 
+def _edges(pr: Prepared, truck: int) -> tuple[np.ndarray, np.ndarray]:
+    """(n, 2) counted edges of each wheel tick of a truck and their rate (1/s)."""
+    n = np.abs(pr.ds[:, truck, :]) / pr.count_mm[truck]
+    return n, n / pr.dt[:, None]
+
+
 def _edge_rates(prs: list, truck: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Every wheel tick of a truck's decoders over the runs: counted edges, edge rate (1/s) and
     whether the decoder flagged a skipped state."""
-    n = [np.abs(pr.ds[:, truck, :]) / pr.count_mm[truck] for pr in prs]
-    r = [k / pr.dt[:, None] for k, pr in zip(n, prs, strict=True)]
+    nr = [_edges(pr, truck) for pr in prs]
     f = [pr.flagged[:, truck, :].ravel() for pr in prs]
-    return (np.concatenate([k.ravel() for k in n]), np.concatenate([k.ravel() for k in r]),
+    return (np.concatenate([n.ravel() for n, _ in nr]), np.concatenate([r.ravel() for _, r in nr]),
             np.concatenate(f))
 
 
@@ -601,10 +606,9 @@ def count_loss_missed(pr: Prepared, ds: np.ndarray, truck: int, scale: float) ->
     flag = pr.flagged[:, truck, :]
     if curve is None or not flag.any():
         return ds
-    c = pr.count_mm[truck]
-    n = np.abs(pr.ds[:, truck, :]) / c
-    lam = np.maximum(_missed_lambda(n, n / pr.dt[:, None], curve, scale), 1e-9)
-    return ds + np.sign(pr.ds[:, truck, :]) * flag * (2.0 * lam / -np.expm1(-lam) * c)
+    lam = np.maximum(_missed_lambda(*_edges(pr, truck), curve, scale), 1e-9)
+    lost = 2.0 * lam / -np.expm1(-lam) * pr.count_mm[truck]  # mm
+    return ds + np.sign(pr.ds[:, truck, :]) * flag * lost
 
 
 def skipped_evidence(prs: list) -> str | None:
