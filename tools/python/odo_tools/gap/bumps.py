@@ -264,7 +264,9 @@ class _Scan:
         self.Ds = [_step_detector(self.e, mm) for mm in self.ms]
         # the step and its side lobes are out of the residual: the scan keeps taken only the
         # bump's own stretch and half a window either side, so that a bump met within two
-        # windows of it is still found (dev 4512 case 16: a cable 260 mm before a stronger one)
+        # windows of it is still found (dev 4512 case 16: a cable 260 mm before a stronger one);
+        # `unmasked` is the scan before the last step taken, this one for a sure step, while
+        # weak ones are fitted once the scan is over and its mask is read no more
         on = np.flatnonzero((Sa[w] >= x[1]) & (Sa[w] <= x[1] + bump_span(pr.R[truck], x[0])))
         on = on[(on >= lo) & (on <= hi)]
         if on.size:
