@@ -41,6 +41,17 @@ def _step_detector(e: np.ndarray, m: int) -> np.ndarray:
     start and end (dev seeds 4005 case 26, a clapper, "unexplained", and 4006 case 34, a LabMate,
     "ed": both over cables). A quarter of the window, not all of it: a bump within the last m
     samples would pull a whole window's mean (the simulator's 2601 case 58 lost its bumps)."""
+    return _steps(e, m)[1]
+
+
+def _inner_step(e: np.ndarray, m: int) -> np.ndarray:
+    """The step between the m samples either side at every sample (continued as in
+    _step_detector), without the outer difference that takes out a drift."""
+    return _steps(e, m)[0]
+
+
+def _steps(e: np.ndarray, m: int) -> tuple[np.ndarray, np.ndarray]:
+    """(inner step, step estimate) at every sample, from one pass over the continued run."""
     ep = np.pad(e, 2 * m, mode="mean", stat_length=max(1, m // 4))
     c = np.concatenate([[0.0], np.cumsum(ep)])
     k = np.arange(2 * m, ep.size - 2 * m)
@@ -48,17 +59,8 @@ def _step_detector(e: np.ndarray, m: int) -> np.ndarray:
     def mean(a, b):
         return (c[b] - c[a]) / m
 
-    D = (mean(k, k + m) - mean(k - m, k)) - (mean(k + m, k + 2 * m) - mean(k - 2 * m, k - m)) / 3
-    return 1.5 * D
-
-
-def _inner_step(e: np.ndarray, m: int) -> np.ndarray:
-    """The step between the m samples either side at every sample (continued as in
-    _step_detector), without the outer difference that takes out a drift."""
-    ep = np.pad(e, m, mode="mean", stat_length=max(1, m // 4))
-    c = np.concatenate([[0.0], np.cumsum(ep)])
-    k = np.arange(m, ep.size - m)
-    return (c[k + m] - 2 * c[k] + c[k - m]) / m
+    inner = mean(k, k + m) - mean(k - m, k)
+    return inner, 1.5 * (inner - (mean(k + m, k + 2 * m) - mean(k - 2 * m, k - m)) / 3)
 
 
 def _phantom(inner: float, D: float) -> bool:
@@ -133,7 +135,7 @@ class _Scan:
         dt = float(np.median(np.diff(tt)))
         widths = sorted({max(3, round(w / dt)) for w in STEP_WIDTHS_S})
         self.ms = [m for m in widths if self.e.size >= 4 * m]
-        self.Ds = [_step_detector(self.e, m) for m in self.ms]
+        self._rescan()
         self.thrs = [
             max(8.0 * _mad(D), 6.0 * sigma_head / math.sqrt(m), 2e-4)
             for D, m in zip(self.Ds, self.ms, strict=True)
@@ -144,6 +146,12 @@ class _Scan:
         self.dd_grid = bump_dd(pr.R[truck], self.h_grid)
         self.Sa = np.stack([np.interp(tt, pr.t, pr.S[:, truck, w]) for w in (0, 1)])
         self.tick_all = np.clip(np.searchsorted(pr.t, tt - 1e-9), 0, pr.t.size - 1)
+
+    def _rescan(self) -> None:
+        """The inner steps and step estimates of the residual at every width."""
+        pairs = [_steps(self.e, m) for m in self.ms]
+        self.Is = [inner for inner, _ in pairs]
+        self.Ds = [D for _, D in pairs]
 
     def strongest(self) -> _Step | None:
         """The strongest step not yet taken at any width, in units of that width's threshold
@@ -169,7 +177,7 @@ class _Scan:
             a = np.array([abs(Dk[q]) for Dk in self.Ds])
             j = int(np.flatnonzero(a >= NATURAL_SHARE * a.max())[0])
             m = self.ms[j]
-            if _phantom(float(_inner_step(self.e, m)[q]), float(self.Ds[j][q])):
+            if _phantom(float(self.Is[j][q]), float(self.Ds[j][q])):
                 self.masked[max(0, q - m // 2) : q + m // 2 + 1] = True
                 continue
             self.unmasked = self.masked.copy()
@@ -261,7 +269,7 @@ class _Scan:
             return None
         _, w, x = best
         self.e = e - _signed_excess(pr, truck, w, x[0], x[1])[self.tick_all]
-        self.Ds = [_step_detector(self.e, mm) for mm in self.ms]
+        self._rescan()
         # the step and its side lobes are out of the residual: the scan keeps taken only the
         # bump's own stretch and half a window either side, so that a bump met within two
         # windows of it is still found (dev 4512 case 16: a cable 260 mm before a stronger one);
