@@ -574,6 +574,89 @@ def test_bumps_join_a_best_only_where_they_halve_the_tracks_excess(
     assert ("the floor bumps" in rk.proposals) is taken
 
 
+def test_bumps_a_held_out_sprint_crosses_without_a_step_leave_a_count_loss(tmp_path: Path) -> None:
+    """Independent world, dev seed 4503 case 41: a LabMate whose decoder counts at most so many
+    edges a second, on wheels of unequal diameters. The count loss at its ceiling, fitted on a
+    sprint, left a step where the sprint's wheels sat on the ceiling, and the bumps detected
+    there joined it: "bumps + count loss + Ed" on a flat floor, the held-out sprint that crosses
+    the spot at 43.9 x the background with the bumps and 4.7 x without them. The bumps leave
+    the verdict (diagnose._bumps_held), and the rest keeps the held-out runs within 2 x."""
+    from odo_tools.gap.diagnose import diagnose
+
+    real = tmp_path / "real"
+    indep_case(4503, 41, real, "labmate", {"count_loss": "rate_limit", "ed": "fixed"})
+    rep = diagnose(real, real / "robot.json", mode="truth").to_dict()
+    v = rep["verdict"]
+    assert v["effect"] == "count_loss+ed", v
+    assert v["laws"]["count_loss"]["law"] == "plateau", v["laws"]
+    said = rep["proposals"]["the floor bumps"]
+    got = re.search(r"cross its bumps at ([0-9.]+) x the background, ([0-9.]+) x without", said)
+    assert got and float(got.group(1)) > 2.0 * float(got.group(2)), said
+    hd = rep["heldout"]
+    assert hd["ratio_after"] < 2.0 < hd["ratio_before"], hd
+
+
+@pytest.mark.parametrize(
+    ("met", "with_bumps", "without", "dropped"),
+    [
+        (1, 25.27, 17.39, True),  # dev 4502 case 38: the bumps raise the crossing sprint
+        (1, 43.89, 4.67, True),  # dev 4503 case 41, the same beside an Ed
+        (1, 2.24, 6.96, False),  # the crossing run wants its bumps
+        (2, 3.70, 4.00, True),  # they remove 15 % of the excess: not enough
+        (2, 3.50, 4.00, False),  # 25 %
+        (1, 0.90, 0.95, True),  # the crossing run sits within the background without them
+        (0, 0.0, 0.0, False),  # no held-out run crosses them: they cannot be judged there
+    ],
+)
+def test_bumps_beside_other_effects_stay_where_the_held_out_runs_crossing_them_want_them(
+    monkeypatch: pytest.MonkeyPatch, met: int, with_bumps: float, without: float, dropped: bool
+) -> None:
+    """The rule of diagnose._bumps_held on the misfit (R, in backgrounds) of the held-out runs
+    that cross the verdict's bumps, with them and without them."""
+    from odo_tools.gap import diagnose
+    from odo_tools.gap.hypotheses import Hypothesis, catalog_law
+
+    prs = [SimpleNamespace(bumps=[]) for _ in range(4)]  # 0, 1 fitted; 2, 3 held out
+
+    def apply(f, hprs, *_):
+        for pr in hprs[:met]:
+            pr.bumps = list(f.bumps)
+        return {}
+
+    def run_gap(item, *_):
+        r = with_bumps if item.bumps else without
+        return SimpleNamespace(z2=100.0 * r * r, n=100), 0.0, 0.0
+
+    def evaluate(prob, name, P, se, k, hyp):
+        return SimpleNamespace(name=name, hyp=hyp, params=P, bumps=[])
+
+    monkeypatch.setattr(diagnose, "apply", apply)
+    monkeypatch.setattr(diagnose, "run_gap", run_gap)
+    monkeypatch.setattr(diagnose, "clear_bumps", lambda ps: [setattr(p, "bumps", []) for p in ps])
+    monkeypatch.setattr(diagnose, "tracked", lambda items: items)
+    monkeypatch.setattr(diagnose, "evaluate", evaluate)
+    monkeypatch.setattr(diagnose, "judge", lambda ds, sel, rk: "judged again")
+    laws = (catalog_law("ed", "labmate"), catalog_law("bumps", "labmate"))
+    best = SimpleNamespace(
+        name="ed+bumps",
+        hyp=Hypothesis(laws),
+        bumps=[_bump("cw:1", ["run-cw-01"], 0.0, 0.0)],
+        params={"ed.value": 1.01, "bumps.height_mm": 9.0},
+        stderr={"ed.value": 0.001},
+        model_params=lambda: {"ed.value": 1.01},
+    )
+    ds = SimpleNamespace(mode="truth", prs=prs, items=prs)
+    rk = SimpleNamespace(best=best, prob=SimpleNamespace(sigma=None), proposals={})
+    sel = SimpleNamespace(fit=[0, 1], held=[2, 3])
+    jd = SimpleNamespace(background=None)
+    got = diagnose._bumps_held(ds, sel, rk, jd)
+    assert (got == "judged again") is dropped
+    assert (rk.best.name == "ed") is dropped
+    assert ("the floor bumps" in rk.proposals) is dropped
+    assert not rk.best.hyp.has_bumps or not dropped
+    assert all(not pr.bumps for pr in prs)  # nothing left placed
+
+
 @pytest.mark.parametrize(
     ("nominal", "best", "bumps", "taken"),
     [
