@@ -114,9 +114,10 @@ def test_every_other_law_has_words_and_units_in_the_report() -> None:
         for law in laws:
             assert law.name in report.LAW_WORDS, law.key
             for p in law.params:
-                # asym, zeta, a scale and the catalog's factors (eb.value) are ratios: no unit
+                # asym, zeta, a scale, an exponent and the catalog's factors (eb.value) are
+                # ratios: no unit
                 assert report.unit(p) != "" or p.endswith(
-                    (".asym", ".zeta", ".value", ".scale")
+                    (".asym", ".zeta", ".value", ".scale", ".exponent")
                 ), p
 
 

@@ -395,11 +395,15 @@ def _grip_speeds(pr: Prepared, ds: np.ndarray, q: float) -> np.ndarray:
 
 def slip_accel(pr: Prepared, ds: np.ndarray, P: dict) -> np.ndarray:
     """Slip tied to the wheel's acceleration as the counts show it, tick by tick: fraction
-    s = min(cap, k (1 -/+ asym) max(0, |a| - a0)) on the left/right wheel, a the change of the
-    tick's mean speed; speeding up the wheel spins (floor = (1 - s) counted), slowing down it
-    drags (floor = counted / (1 - s)). No motor lag, no sub-steps: the law a user would write
-    down from the counts alone. Tyres differ: with one k for both, a truck that turned a little
-    on every start left 5.9 x the background (independent world, seed 2701 case 2)."""
+    s = min(cap, k (1 -/+ asym) max(0, |a| - a0)^exponent) on the left/right wheel, a the
+    change of the tick's mean speed (m/s^2); speeding up the wheel spins (floor = (1 - s)
+    counted), slowing down it drags (floor = counted / (1 - s)). No motor lag, no sub-steps:
+    the law a user would write down from the counts alone. Tyres differ: with one k for both,
+    a truck that turned a little on every start left 5.9 x the background (independent world,
+    seed 2701 case 2). The exponent: under a linear law (1) a move's spin while speeding up and
+    its drag while slowing down cancel whatever the two rates (each k v^2 / 2), under a power
+    they do not where the rates differ, and a LabMate's spot turns each left a heading step
+    that the linear law could not give and an Eb took up ("eb + slip", dev 4501 case 44)."""
     k = P["slip@accel.k_per_m_s2"]
     a0 = P.get("slip@accel.a0_m_s2", 0.0)
     asym = P.get("slip@accel.asym", 0.0)
@@ -408,7 +412,7 @@ def slip_accel(pr: Prepared, ds: np.ndarray, P: dict) -> np.ndarray:
     vp = np.vstack([np.zeros((1, 2)), v[:-1]])
     a = np.abs(v - vp) / pr.dt[:, None] * 1e-3
     kw = k * np.array([1.0 - asym, 1.0 + asym])
-    s = np.minimum(kw * np.maximum(a - a0, 0.0), cap)
+    s = np.minimum(kw * np.maximum(a - a0, 0.0) ** P.get("slip@accel.exponent", 1.0), cap)
     up = np.abs(v) >= np.abs(vp)
     return ds * np.where(up, 1.0 - s, 1.0 / (1.0 - s))
 

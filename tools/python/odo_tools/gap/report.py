@@ -39,7 +39,7 @@ WORDS = {
 }
 LAW_WORDS = {
     "catalog": "the catalog's law",
-    "accel": "slip fraction proportional to the wheel's acceleration above a threshold, "
+    "accel": "slip fraction a power of the wheel's acceleration above a threshold, "
     "one grip per tyre",
     "traction": "traction (torque) saturation: the floor speed changes by at most what the "
     "friction circle of a_max leaves beside the turn",
@@ -103,6 +103,7 @@ def unit(key: str) -> str:
             "a_m_s2": "m/s^2",
             "a_lim_m_s2": "m/s^2",
             "zeta": "1",
+            "exponent": "1",
             "counts": "counts per flagged tick",
         }.get(p, "")
         if p.endswith("_deg"):  # the once-per-turn terms of a joint encoder's offset
