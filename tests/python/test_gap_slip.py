@@ -64,11 +64,11 @@ def test_accel_slip_by_a_power_leaves_a_move_short_where_it_brakes_harder_than_i
 
 def test_a_labmates_slip_on_its_spot_turns_is_named_slip_by_the_power_law(tmp_path: Path) -> None:
     """Independent world, dev seed 4501 case 44: a LabMate whose tyres slip by k |a|^p (p 1.25,
-    the right tyre 15 % more). Most of its misfit lies in the spot turns, which the phases count
-    as turns, so nothing proposed slip's other laws: "unexplained", the catalog's slip leaving
-    the held-out runs at 3.3 x the background. Tried always and linear in the acceleration, the
-    law left a heading step per turn that an Eb took up ("eb + slip"); with the power it is
-    slip alone."""
+    k 15 % below and above its mean on the left and right). Most of its misfit lies in the spot
+    turns, which the phases count as turns, so nothing proposed slip's other laws:
+    "unexplained", the catalog's slip leaving the held-out runs at 3.3 x the background. Tried
+    always and linear in the acceleration, the law left a heading step per turn that an Eb took
+    up ("eb + slip"); with the power it is slip alone."""
     _, rep = indep_named(4501, 44, tmp_path, "labmate", {"slip": "accel"}, "slip", "accel")
     assert rep["verdict"]["params"]["slip@accel.exponent"] != 1.0
     hd = rep["heldout"]
