@@ -1315,12 +1315,20 @@ def _kept_sizes(sub: Fit, parent: Fit, prob: Problem) -> Fit | None:
     5.1 mm."""
     if sub.hyp is None or sub.hyp.has_bumps:
         return None
-    P = parent.model_params()
     keys = list(sub.params)
-    if not keys or any(k not in P for k in keys):
+    if not keys or any(k not in parent.model_params() for k in keys):
         return None
-    se = {k: parent.stderr.get(k, sub.stderr.get(k, 0.0)) for k in keys}
-    return evaluate(prob, sub.name, {k: P[k] for k in keys}, se, len(sub.hyp.params), hyp=sub.hyp)
+    return _at_sizes(sub.hyp, parent, prob, keys, sub.stderr)
+
+
+def _at_sizes(
+    h: hypotheses.Hypothesis, parent: Fit, prob: Problem, keys: list[str], se_else: dict
+) -> Fit:
+    """Hypothesis `h` evaluated at the sizes its parameters `keys` have in `parent` (standard
+    errors from the parent, else from `se_else`)."""
+    P = parent.model_params()
+    se = {k: parent.stderr.get(k, se_else.get(k, 0.0)) for k in keys}
+    return evaluate(prob, h.name, {k: P[k] for k in keys}, se, len(h.params), hyp=h)
 
 
 def floor_walk(prob: Problem, vehicle: str, pool: list | None = None) -> Background:
@@ -1695,9 +1703,7 @@ def _bumps_held(ds: Dataset, sel: Selection, rk: Ranking, jd: Judgement) -> Judg
     if z0 > 1.0 and zw <= z0 - BUMPS_HELD_SHARE * (z0 - 1.0):
         return jd
     h = hypotheses.Hypothesis(rest)
-    P = best.model_params()
-    se = {k: best.stderr.get(k, 0.0) for k in P}
-    g = evaluate(rk.prob, h.name, P, se, len(h.params), hyp=h)  # the sizes fitted beside them
+    g = _at_sizes(h, best, rk.prob, list(best.model_params()), {})  # as fitted beside them
     rk.proposals["the floor bumps"] = (
         f"{best.name} leaves the {len(met)} held-out run(s) that cross its bumps at "
         f"{math.sqrt(zw):.2f} x the background, {math.sqrt(z0):.2f} x without the bumps: "
