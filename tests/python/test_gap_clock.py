@@ -39,6 +39,23 @@ def test_a_drifting_truth_clock_is_unexplained_with_its_rate(tmp_path: Path) -> 
     assert steps[0].startswith("stamp the truth with the robot's clock"), steps
 
 
+def test_a_clock_read_at_five_to_eight_standard_errors_is_unexplained(tmp_path: Path) -> None:
+    """Dev seed 4520 case 54: a clapper with no effect whose motion capture drifts -321 ppm.
+    Its held-out runs sit at 0.88 x the background, and nine of nine runs read -397 +- 73 ppm,
+    5.4 standard errors; the verdict was "no significant gap" while the rate needed 8."""
+    from odo_tools.gap.diagnose import diagnose
+
+    real = tmp_path / "real"
+    c = indep_case(4520, 54, real, "clapper", {"clock_drift": "linear"})
+    rep = diagnose(real, real / "robot.json", mode="truth").to_dict()
+    true = c["true"]["effects"]["clock_drift"]["ppm"]
+    cr = rep["instrument"]["clock_rate"]
+    assert 5.0 <= abs(cr["ppm"]) / cr["se_ppm"] < 8.0, cr
+    assert cr["ppm"] * true > 0 and abs(cr["ppm"] - true) < 0.4 * abs(true), (cr, true)
+    assert rep["verdict"]["effect"] == "unexplained", rep["verdict"]
+    assert "the truth's clock runs" in rep["verdict"]["reason"], rep["verdict"]
+
+
 def test_a_skid_is_named_beside_a_clock_that_restamping_does_not_confirm(tmp_path: Path) -> None:
     """Dev seed 4061 case 14: a LabMate whose floor gives 0.56 m/s^2 and whose truth keeps the
     robot's time. Under the friction skid named (96 % of the held-out misfit removed) the runs'
@@ -107,7 +124,9 @@ def test_a_clock_needs_many_runs_that_agree_on_a_real_rate() -> None:
 
     assert ClockRate(600.0, 30.0, 9, 10, 50.0).drifting()
     assert not ClockRate(150.0, 5.0, 9, 10, 50.0).drifting()  # too slow to matter
-    assert not ClockRate(-600.0, 90.0, 9, 10, 50.0).drifting()  # the runs scatter
+    assert not ClockRate(-600.0, 150.0, 9, 10, 50.0).drifting()  # the runs scatter
+    assert ClockRate(-397.0, 73.0, 9, 9, 50.0).drifting()  # dev 4520 case 54: 5.4 se
+    assert not ClockRate(-445.0, 117.0, 9, 9, 50.0).drifting()  # 3.8 se (dev 4502 case 6)
     assert not ClockRate(600.0, 30.0, 6, 10, 50.0).drifting()  # too few of the runs
     assert not ClockRate(600.0, 30.0, 3, 3, 50.0).drifting()  # too few runs
 
