@@ -525,12 +525,13 @@ def lever_arm(
 CLOCK_RATE_MIN_PPM = 200.0  # a truth clock drifting less than this is left alone
 # the runs' median rate in standard errors of it (their scatter / sqrt(n)). Was 8: one truth clock
 # of dev seed 4520 (case 54, -321 ppm drawn) read -397 +- 73 ppm, 9 of 9 runs agreeing, and
-# stayed "no significant gap" (held-out 0.88 x the background). Of the 197 robots of dev seeds
+# stayed "no significant gap" (held-out 0.88 x the background). Of the 266 robots of dev seeds
 # 4501-4520 scanned (all of 4501-4502, and those with no effect or one out of the catalog of
-# 4513-4520), the 172 whose truth keeps the robot's time read 200 ppm or more with the runs
-# agreeing at 3.1 standard errors at most (a diameter drift), but for a set's gear backlash
-# (250 ppm at 8.5, out of the catalog either way); 21 of the 25 clocks that drift read 200 ppm
-# or more at 5.4 standard errors or more (the other four under 200 ppm, or at 2.3 and 3.6)
+# 4513-4520), 197 gave a rate. The 172 of those whose truth keeps the robot's time read 200 ppm
+# or more with the runs agreeing at 3.1 standard errors at most (a diameter drift), but for a
+# set's gear backlash (250 ppm at 8.5, out of the catalog either way); 21 of the 25 clocks that
+# drift read 200 ppm or more at 5.4 standard errors or more (the other four under 200 ppm, or
+# at 2.3 and 3.6)
 CLOCK_RATE_Z = 5.0
 CLOCK_RATE_RUNS = 2.0 / 3.0  # the share of the truth runs whose both thirds fix a latency
 CLOCK_RATE_MIN_RUNS = 4
