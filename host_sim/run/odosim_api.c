@@ -294,3 +294,8 @@ int odosim_rate_limit_2d(const double *vx, const double *vy, const double *lim, 
 {
     return sim_rate_limit_2d(vx, vy, lim, n, ox, oy);
 }
+
+int odosim_rate_limit_track(const double *pose, size_t n, const double *dt, double acc, double *out)
+{
+    return sim_rate_limit_track(pose, n, dt, acc, out);
+}

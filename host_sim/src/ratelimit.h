@@ -15,4 +15,11 @@ int sim_rate_limit(const double *v, const double *lim, size_t n, double *out);
 /// lim[i] / |d|), d = (vx, vy)[i] - (ox, oy)[i-1], from (0, 0). 0, or -1 on a NULL array.
 int sim_rate_limit_2d(const double *vx, const double *vy, const double *lim, size_t n, double *ox, double *oy);
 
+/// Its form on a track (model.py skid_friction, the friction circle): pose and out are
+/// (n, 3) x, y, theta rows, dt the n - 1 steps (s). The wanted velocity of step i is pose's
+/// (row i+1 - row i) / dt[i]; the followed one changes by at most acc dt[i] (acc in the track's
+/// unit per s^2), from rest; out's x, y are pose's start plus the followed velocity's running
+/// sum, out's theta pose's. out may not alias pose. 0, or -1 on a NULL or aliased array.
+int sim_rate_limit_track(const double *pose, size_t n, const double *dt, double acc, double *out);
+
 #endif

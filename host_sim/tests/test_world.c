@@ -477,7 +477,8 @@ START_TEST(clapper_stop_replayed_over_a_track_pushes_half_way_and_obeys_its_gate
 END_TEST
 
 /* The floor that follows a wheel by at most lim per step: a step from 0 to 10 with lim 3 is
- * reached in four steps (3, 6, 9, 10), a drop to 0 the same way down; NULL arrays are refused. */
+ * reached in four steps (3, 6, 9, 10), a drop to 0 the same way down; its plane form on a pose
+ * track (the friction circle); NULL and aliased arrays are refused. */
 START_TEST(rate_limiter_follows_its_input_by_at_most_the_limit)
 {
     const double v[8] = {10.0, 10.0, 10.0, 10.0, 10.0, 0.0, 0.0, 0.0};
@@ -507,6 +508,32 @@ START_TEST(rate_limiter_follows_its_input_by_at_most_the_limit)
     ck_assert_double_eq_tol(oy[3], 4.0 - 2.0 / sqrt(50.0), 1e-12);
     ck_assert_int_eq(sim_rate_limit_2d(vx, NULL, l2, 4U, ox, oy), -1);
     ck_assert_int_eq(sim_rate_limit_2d(vx, vy, l2, 4U, ox, NULL), -1);
+
+    /* and on a pose track whose steps ask the same velocities: the followed ones summed from
+     * the start (1, 2), the heading the track's */
+    const double pose[15] = {1.0, 2.0, 0.1, 4.0, 6.0, 0.2, 7.0, 10.0, 0.3, 10.0, 14.0, 0.4, 6.0, 17.0, 0.5};
+    const double dt[4] = {1.0, 1.0, 1.0, 1.0};
+    double track[15];
+    ck_assert_int_eq(sim_rate_limit_track(pose, 5U, dt, 2.0, track), 0);
+    const double follows[15] = {
+        1.0, 2.0, 0.1, 2.2, 3.6, 0.2, 4.6, 6.8, 0.3, 7.6, 10.8, 0.4, 10.6 - 14.0 / sqrt(50.0), 14.8 - 2.0 / sqrt(50.0),
+        0.5};
+    for (size_t i = 0; i < 15U; ++i) {
+        ck_assert_double_eq_tol(track[i], follows[i], 1e-12);
+    }
+    /* half-second steps: the wanted velocity (6, 8), limited to acc dt = 2 a step, (1.2, 1.6)
+     * for half a second */
+    const double half[4] = {0.5, 0.5, 0.5, 0.5};
+    ck_assert_int_eq(sim_rate_limit_track(pose, 5U, half, 4.0, track), 0);
+    ck_assert_double_eq_tol(track[3], 1.6, 1e-12);
+    ck_assert_double_eq_tol(track[4], 2.8, 1e-12);
+    ck_assert_int_eq(sim_rate_limit_track(pose, 1U, dt, 2.0, track), 0); /* the start alone */
+    ck_assert_double_eq(track[2], 0.1);
+    ck_assert_int_eq(sim_rate_limit_track(pose, 0U, dt, 2.0, track), 0);
+    ck_assert_int_eq(sim_rate_limit_track(NULL, 5U, dt, 2.0, track), -1);
+    ck_assert_int_eq(sim_rate_limit_track(pose, 5U, NULL, 2.0, track), -1);
+    ck_assert_int_eq(sim_rate_limit_track(pose, 5U, dt, 2.0, NULL), -1);
+    ck_assert_int_eq(sim_rate_limit_track(track, 5U, dt, 2.0, track), -1);
 }
 END_TEST
 

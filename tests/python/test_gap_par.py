@@ -108,22 +108,34 @@ def test_diagnosis_is_the_same_on_one_core_and_two(tmp_path) -> None:
 
 
 @pytest.mark.skipif(not TWO, reason="one core: nothing runs beside the parent")
-def test_lever_arms_under_skid_subsets_are_the_same_on_two_cores(tmp_path) -> None:
+def test_lever_arms_under_skid_subsets_are_the_same_on_two_cores(
+    tmp_path, monkeypatch: pytest.MonkeyPatch
+) -> None:
     """The lever arms read under each subset of skidding trucks (a clapper with a skid on truck
     A and truck B's marker 25 mm behind its axle, dev seed 2761 case 44): the winner's items
     are rebuilt in the parent from its instrument, and must be the ones that instrument gives,
-    on one core or two."""
+    on one core or two. On two, the first two readings run side by side, and the friction
+    circle's reading is read ahead beside the three cornering ones (the gap asks for it)."""
     from odo_tools.gap import diagnose as D
     from odo_tools.gap import par
     from odo_tools.gap.modes import TruthMode
 
     real = tmp_path / "real"
     indep_case(2761, 44, real, "clapper", {"skid": "cornering"})
-    got = []
+    got, batches = [], {}
+    each = par.each
+
+    def counted(tasks, *a, **k):
+        batches[par.jobs()].append(len(tasks))
+        return each(tasks, *a, **k)
+
+    monkeypatch.setattr(par, "each", counted)
     for jobs in (1, 2):
+        batches[jobs] = []
         with par.cores(jobs):
             ds = D.load(real, real / "robot.json")
         got.append(ds)
+    assert batches[1][:2] == [2, 3] and batches[2][:2] == [2, 4]
     a, b = got
     assert any("cornering skid" in n for n in a.notes)
     assert np.hypot(*a.instrument.lever_mm[1]) > 10.0  # the rebuilt items carry it

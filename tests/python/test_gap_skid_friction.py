@@ -50,23 +50,32 @@ def test_friction_skid_leaves_a_track_the_floor_can_follow_alone() -> None:
 
 
 def test_friction_limiter_in_libodosim_is_the_plain_replay() -> None:
-    """simlib.rate_limit_2d (host_sim/src/ratelimit.c) against the rule written out per step."""
-    from odo_tools.gap.simlib import rate_limit_2d
+    """simlib.rate_limit_track (host_sim/src/ratelimit.c) against the rule written out per step,
+    and its shape checks (test_gap_speed holds model.skid_friction to numpy's form bit for bit)."""
+    from odo_tools.gap.simlib import rate_limit_track
 
     rng = np.random.default_rng(4)
     v = np.cumsum(rng.normal(0.0, 40.0, (500, 2)), axis=0)
-    lim = rng.uniform(5.0, 60.0, 500)
-    want, cur = np.empty_like(v), np.zeros(2)
+    dt = rng.uniform(0.01, 0.03, 500)
+    pose = np.zeros((501, 3))
+    pose[1:, :2] = np.cumsum(v * dt[:, None], axis=0)
+    pose[:, 2] = rng.normal(size=501)
+    acc = 2000.0
+    want, cur = pose.copy(), np.zeros(2)
     for i in range(v.shape[0]):
-        d = v[i] - cur
-        m = float(np.hypot(*d))
-        cur = cur + (d * (lim[i] / m) if m > lim[i] else d)
-        want[i] = cur
-    got = rate_limit_2d(v, lim)
+        d = (pose[i + 1, :2] - pose[i, :2]) / dt[i] - cur
+        m, lim = float(np.hypot(*d)), acc * dt[i]
+        cur = cur + (d * (lim / m) if m > lim else d)
+        want[i + 1, :2] = want[i, :2] + cur * dt[i]
+    got = rate_limit_track(pose, dt, acc)
     assert np.allclose(got, want, atol=1e-9, rtol=0.0)
-    assert not np.allclose(got, v)  # the limit bit: the comparison can fail
+    assert np.array_equal(got[:, 2], pose[:, 2])
+    assert not np.allclose(got, pose)  # the limit bit: the comparison can fail
+    for bad in (dt[:-1], np.append(dt, 0.02)):
+        with pytest.raises(ValueError):
+            rate_limit_track(pose, bad, acc)
     with pytest.raises(ValueError):
-        rate_limit_2d(v, lim[:-1])
+        rate_limit_track(pose[:, :2], dt, acc)
 
 
 def test_load_dependent_wheelbase_divides_each_ticks_turn() -> None:

@@ -258,3 +258,69 @@ def test_rate_ceiling_law_over_every_stretch_at_once_is_the_per_stretch_loop_bit
         assert np.array_equal(got, want), E
         assert not np.array_equal(got, ds)  # the law adds travel: the comparison can fail
         assert np.array_equal(count_loss_plateau(pr, ds, 0, P), got)  # served from the cache
+
+
+def test_scrub_factor_column_by_column_is_the_row_reduction_bit_for_bit() -> None:
+    from odo_tools.gap.model import scrub_factor
+
+    ds = _wheels(np.random.default_rng(11), 2000)
+    ds[7] = (0.0, 0.0)  # a tick at rest: v = 0
+    ds[8] = (-0.0, 0.3)
+    for k in (0.008, -0.05, 0.4):
+        a = np.abs(ds)  # the form it replaced: numpy's reductions along each row
+        same = (ds[:, 0] * ds[:, 1]) > 0.0
+        m = np.where(same, 2.0 * a.min(axis=1), 0.0)
+        v = a.sum(axis=1)
+        want = 1.0 - k * m / np.where(v > 0.0, v, 1.0)
+        got = scrub_factor(ds, k)
+        assert np.array_equal(got, want), k
+        assert not np.all(got == 1.0)  # the factor acts: the comparison can fail
+    assert scrub_factor(ds, 0.0) is None
+
+
+@pytest.mark.parametrize("truck", [0, 1])
+def test_truck_view_in_one_pass_is_the_two_comprehensions(truck: int) -> None:
+    from odo_tools.gap.model import truck_view
+
+    def plain(P: dict, truck: int) -> dict:
+        out = {k: v for k, v in P.items() if not k.endswith((".A", ".B"))}
+        suf = "." + "AB"[truck]
+        out.update({k[:-2]: v for k, v in P.items() if k.endswith(suf)})
+        return out
+
+    keys = ["ed.value", "es.value.A", "es.value.B", "skid@friction.a_lim_m_s2.B", "eb.value",
+            "eb.value.A", "scrub.k", "x.AB", "y.C", ".A", "B", "ab"]  # fmt: skip
+    rng = np.random.default_rng(3)
+    for _ in range(300):
+        P = {k: float(rng.normal()) for k in rng.permutation(keys)[: rng.integers(0, 13)]}
+        got, want = truck_view(P, truck), plain(P, truck)
+        assert got == want and list(got) == list(want), P  # the same values, the same order
+
+
+def test_friction_skid_in_c_is_numpys_form_bit_for_bit() -> None:
+    from odo_tools.gap.model import integrate, skid_friction
+
+    rng = np.random.default_rng(8)
+    ds = _wheels(rng, 1200)
+    pr = _prepared(ds[:, None, :])
+    pr.dt = 0.02 + rng.uniform(0.0, 1e-4, ds.shape[0])  # jittered ticks
+    p = integrate(ds, 340.0, np.zeros(ds.shape[0]), pose0=(120.0, -40.0, 0.3))
+    for a_lim in (0.05, 0.3, 2.0):
+        # the form it replaced: numpy's velocities and sums around the per-step limiter
+        v = np.diff(p[:, :2], axis=0) / pr.dt[:, None]
+        lim = a_lim * 1e3 * pr.dt
+        u, cx, cy = np.empty_like(v), 0.0, 0.0
+        for i in range(v.shape[0]):
+            dx, dy = v[i, 0] - cx, v[i, 1] - cy
+            m = float(np.hypot(dx, dy))  # libm's hypot, as ratelimit.c's
+            f = lim[i] / m if m > lim[i] else 1.0
+            cx, cy = cx + f * dx, cy + f * dy
+            u[i] = cx, cy
+        want = p.copy()
+        np.cumsum(u[:, 0] * pr.dt, out=want[1:, 0])
+        np.cumsum(u[:, 1] * pr.dt, out=want[1:, 1])
+        want[1:, :2] += p[0, :2]
+        got = skid_friction(pr, p, a_lim)
+        assert np.array_equal(got, want), a_lim
+        if a_lim < 1.0:
+            assert not np.allclose(got, p)  # the floor lets go: the comparison can fail

@@ -166,8 +166,15 @@ long odosim_link_clamp(const double *rel, size_t n, double lo_mm, double hi_mm, 
 int odosim_rate_limit(const double *v, const double *lim, size_t n, double *out);
 
 /// Its plane form (a friction circle, sim_rate_limit_2d): the vector (ox, oy) follows (vx, vy)
-/// by at most lim[i] per step, from (0, 0). 0, or -1 on a NULL array.
+/// by at most lim[i] per step, from (0, 0). 0, or -1 on a NULL array. (The diagnosis calls the
+/// track form below since; kept, as `make bench-gap REF=<rev>` loads older packages beside
+/// this library.)
 int odosim_rate_limit_2d(const double *vx, const double *vy, const double *lim, size_t n, double *ox, double *oy);
+
+/// The plane limiter on a pose track (sim_rate_limit_track; the friction circle's skid): out's
+/// x, y follow pose's (n, 3) rows with a velocity that changes by at most acc dt[i] per step,
+/// out's theta is pose's. 0, or -1 on a NULL or aliased array.
+int odosim_rate_limit_track(const double *pose, size_t n, const double *dt, double acc, double *out);
 
 #ifdef __cplusplus
 }

@@ -240,14 +240,21 @@ def _lever_on_arcs(ds: Dataset) -> None:
     keys = [k for k in PRELIM if k.split(".")[0] in catalog.hypotheses("truth", ds.robot.vehicle)]
     if ds.robot.n_trucks > 1:
         keys = _per_truck(keys, "es.value")
-    best = _lever_rounds(ds, keys)
     # the markers read first under the nominal geometry too: the first round's fit, made with
     # the markers on the axles, can hold the pair the rounds settle on far off (an Ed on one
     # truck of a clapper, 10 ms ticks, no spot turns: the fit's Eb 1.018 put both markers
     # 2.3-2.8 mm forward of where the nominal geometry reads them, within 0.4 mm of the true;
     # deviance 12386 against 8737; independent world 3071 case 54, traced after that seed was
     # measured); the two readings compete with the skid's below, by the same measure
-    nom = _lever_rounds(ds, keys, nominal_first=True)
+    best, nom = (
+        _with_items(ds, r)
+        for r in par.each(
+            [
+                functools.partial(_lever_reading, ds, keys),
+                functools.partial(_lever_reading, ds, keys, nominal_first=True),
+            ]
+        )
+    )
     if "skid" in catalog.hypotheses("truth", ds.robot.vehicle):
         best = _lever_with_skid(ds, keys, best, nom)
     elif _deviance(nom, best.sigma)[0] < _deviance(best, best.sigma)[0]:
@@ -274,6 +281,16 @@ class _Levers(NamedTuple):
     items: list
     sigma: np.ndarray  # the noise scale of the last round's problem
     P: dict  # its fitted geometry
+
+
+def _lever_reading(ds: Dataset, keys: list[str], nominal_first: bool = False) -> _Levers:
+    """`_lever_rounds` without its items, which a worker of par.each would pickle back with
+    every run they hold: `_with_items` rebuilds them from the reading's instrument."""
+    return _lever_rounds(ds, keys, nominal_first=nominal_first)._replace(items=None)
+
+
+def _with_items(ds: Dataset, r: _Levers) -> _Levers:
+    return r._replace(items=[TruthMode(pr, ds.robot, r.inst) for pr in ds.prs])
 
 
 def _deviance(r: _Levers, sigma: np.ndarray) -> tuple[float, float, int]:
@@ -331,7 +348,17 @@ def _lever_with_skid(ds: Dataset, keys: list[str], best: _Levers, nom: _Levers) 
         best, cost = nom, c
     corner = each(kc)
     subsets = [[k for i, k in enumerate(corner) if m >> i & 1] for m in range(1, 1 << len(corner))]
-    for r, dev, chi, n in par.each([functools.partial(reading, sk) for sk in subsets]):
+    tasks = [functools.partial(reading, sk) for sk in subsets]
+    # the friction circle's reading (below) is the longest of them, three starts a round (a
+    # clapper's skid on a 0.23 m/s^2 floor: 12 s of a 38 s diagnosis after 9 s of the three
+    # cornering readings on two cores): where the gap left so far asks for it and a second
+    # core is free it is read first, beside the cornering ones, and dropped if they close it
+    ahead = left >= R_GAP * R_GAP and par.jobs() > 1
+    if ahead:
+        tasks.insert(0, functools.partial(reading, each(FRICTION_LIMIT)))
+    got = par.each(tasks)
+    friction = got.pop(0) if ahead else None
+    for r, dev, chi, n in got:
         if (c := qbic(r, dev, n)) < cost:
             best, cost, left = r, c, chi / n
     # and under a friction circle's skid, on every driven truck at once (the floor's grip),
@@ -342,12 +369,10 @@ def _lever_with_skid(ds: Dataset, keys: list[str], best: _Levers, nom: _Levers) 
     # Asked beside the cornering readings on every robot with a gap, it took a clapper's
     # cornering skid at 10 ms ticks from 8 s to 18 s (4071 case 10)
     if left >= R_GAP * R_GAP:
-        r, dev, chi, n = reading(each(FRICTION_LIMIT))
+        r, dev, chi, n = friction or reading(each(FRICTION_LIMIT))
         if (c := qbic(r, dev, n)) < cost:
             best, cost = r, c
-    if best.items is None:
-        best = best._replace(items=[TruthMode(pr, ds.robot, best.inst) for pr in ds.prs])
-    return best
+    return best if best.items is not None else _with_items(ds, best)
 
 
 def _lever_rounds(ds: Dataset, keys: list[str], nominal_first: bool = False) -> _Levers:

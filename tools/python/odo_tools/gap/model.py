@@ -189,9 +189,15 @@ def truck_view(P: dict, truck: int) -> dict:
     """The parameters that act on one truck: 'effect.param' acts on every truck, and
     'effect.param.A' / '.B' on that truck only (a hypothesis scoped to one truck: the
     independent world puts a truck-scoped effect on one truck of a clapper or set)."""
-    out = {k: v for k, v in P.items() if not k.endswith((".A", ".B"))}
-    suf = "." + "AB"[truck]
-    out.update({k[:-2]: v for k, v in P.items() if k.endswith(suf)})
+    # one pass, the same dict as {shared} updated with {own} (the fits ask 600 000 times)
+    out, own, suf = {}, {}, "AB"[truck]
+    for k, v in P.items():
+        if k[-2:-1] == "." and k[-1] in "AB":
+            if k[-1] == suf:
+                own[k[:-2]] = v
+        else:
+            out[k] = v
+    out.update(own)
     return out
 
 
@@ -304,10 +310,12 @@ def scrub_factor(ds: np.ndarray, k: float) -> np.ndarray | None:
     g = 1 - k m / v, v = |dL| + |dR|, m = 2 min(|dL|, |dR|) when both wheels roll one way."""
     if k == 0.0:
         return None
-    a = np.abs(ds)
-    v = a.sum(axis=1)
+    # column by column: the same sums and minima as a.sum(axis=1), a.min(axis=1), which numpy
+    # reduces slowly along a short axis (a third of a friction skid's fit went there)
+    al, ar = np.abs(ds[:, 0]), np.abs(ds[:, 1])
+    v = al + ar
     same = (ds[:, 0] * ds[:, 1]) > 0.0
-    m = np.where(same, 2.0 * a.min(axis=1), 0.0)
+    m = np.where(same, 2.0 * np.minimum(al, ar), 0.0)
     return 1.0 - k * m / np.where(v > 0.0, v, 1.0)
 
 
@@ -951,14 +959,8 @@ def skid_friction(pr: Prepared, p: np.ndarray, a_lim: float) -> np.ndarray:
     skid above a threshold (the catalog's, and skid_cornering's slip angle) grows with the
     excess; this one is all or nothing per tick, which a floor that gives way at a grip limit
     shows (the independent world's laws.friction_circle is one such)."""
-    dt = pr.dt
-    v = np.diff(p[:, :2], axis=0) / dt[:, None]
-    u = simlib.rate_limit_2d(v, a_lim * 1e3 * dt)
-    out = p.copy()
-    np.cumsum(u[:, 0] * dt, out=out[1:, 0])
-    np.cumsum(u[:, 1] * dt, out=out[1:, 1])
-    out[1:, :2] += p[0, :2]
-    return out
+    # in C, the numbers numpy took (np.diff / dt, the limiter, cumsum of u dt plus the start)
+    return simlib.rate_limit_track(p, pr.dt, a_lim * 1e3)
 
 
 def accel_demand(prs: list, q: float = 99.0) -> float:

@@ -48,6 +48,11 @@ def cores(jobs: int | None) -> Iterator[int]:
         _jobs = old
 
 
+def jobs() -> int:
+    """The worker processes a batch may use now (1 inside a task, and outside `cores`)."""
+    return _jobs
+
+
 def _call(i: int) -> object:
     global _jobs
     _jobs = 1  # a task that asks for a batch runs it in its own process

@@ -136,7 +136,7 @@ def lib() -> C.CDLL:
         dbl,
     ]
     so.odosim_rate_limit.argtypes = [dbl, dbl, C.c_size_t, dbl]
-    so.odosim_rate_limit_2d.argtypes = [dbl, dbl, dbl, C.c_size_t, dbl, dbl]
+    so.odosim_rate_limit_track.argtypes = [dbl, C.c_size_t, dbl, C.c_double, dbl]
     bad = check_layouts(so)
     if bad:
         raise GapInputError(lib_path(), "ctypes layouts do not match libodosim: " + "; ".join(bad))
@@ -201,25 +201,20 @@ def rate_limit(v: np.ndarray, lim: np.ndarray) -> np.ndarray:
     return out
 
 
-def rate_limit_2d(v: np.ndarray, lim: np.ndarray) -> np.ndarray:
-    """The plane form (host_sim/src/ratelimit.c sim_rate_limit_2d, a friction circle): (n, 2)
-    vectors following v (n, 2) by at most lim_i (n,) per step, from (0, 0)."""
-    v = np.asarray(v, dtype=np.float64)
-    lim = np.ascontiguousarray(lim, dtype=np.float64)
-    if v.ndim != 2 or v.shape[1] != 2 or lim.shape != (v.shape[0],):
-        raise ValueError(f"rate_limit_2d: shapes {v.shape} and {lim.shape}")
-    vx, vy = np.ascontiguousarray(v[:, 0]), np.ascontiguousarray(v[:, 1])
-    ox, oy = np.empty_like(vx), np.empty_like(vy)
+def rate_limit_track(pose: np.ndarray, dt: np.ndarray, acc: float) -> np.ndarray:
+    """host_sim/src/ratelimit.c sim_rate_limit_track: (n, 3) the track pose (x, y, theta rows)
+    followed by a velocity that changes by at most acc dt_i per step (dt: the n - 1 steps)."""
+    pose = np.ascontiguousarray(pose, dtype=np.float64)
+    dt = np.ascontiguousarray(dt, dtype=np.float64)
+    if pose.ndim != 2 or pose.shape[1] != 3 or dt.shape != (max(pose.shape[0] - 1, 0),):
+        raise ValueError(f"rate_limit_track: shapes {pose.shape} and {dt.shape}")
+    out = np.empty_like(pose)
     dbl = C.POINTER(C.c_double)
-    lib().odosim_rate_limit_2d(
-        vx.ctypes.data_as(dbl),
-        vy.ctypes.data_as(dbl),
-        lim.ctypes.data_as(dbl),
-        vx.size,
-        ox.ctypes.data_as(dbl),
-        oy.ctypes.data_as(dbl),
-    )
-    return np.column_stack([ox, oy])
+    lib().odosim_rate_limit_track(
+        pose.ctypes.data_as(dbl), pose.shape[0], dt.ctypes.data_as(dbl), float(acc),
+        out.ctypes.data_as(dbl),
+    )  # fmt: skip
+    return out
 
 
 @lru_cache(maxsize=1)
