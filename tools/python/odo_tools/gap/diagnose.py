@@ -290,6 +290,7 @@ def _lever_reading(ds: Dataset, keys: list[str], nominal_first: bool = False) ->
 
 
 def _with_items(ds: Dataset, r: _Levers) -> _Levers:
+    """r with the runs' items under its instrument (as `_lever_rounds` builds them)."""
     return r._replace(items=[TruthMode(pr, ds.robot, r.inst) for pr in ds.prs])
 
 
@@ -349,10 +350,10 @@ def _lever_with_skid(ds: Dataset, keys: list[str], best: _Levers, nom: _Levers) 
     corner = each(kc)
     subsets = [[k for i, k in enumerate(corner) if m >> i & 1] for m in range(1, 1 << len(corner))]
     tasks = [functools.partial(reading, sk) for sk in subsets]
-    # the friction circle's reading (below) is the longest of them, three starts a round (a
-    # clapper's skid on a 0.23 m/s^2 floor: 12 s of a 38 s diagnosis after 9 s of the three
-    # cornering readings on two cores): where the gap left so far asks for it and a second
-    # core is free it is read first, beside the cornering ones, and dropped if they close it
+    # the friction circle's reading (below) is the longest, four starts a round (11.4 s of the
+    # 39 s a clapper skidding on a 0.23 m/s^2 floor took on two cores, fresh seed 3411 case
+    # 44): where the gap left so far asks for it and a second core is free, it is read first,
+    # beside the cornering ones, and dropped if they close the gap (the same result, sooner)
     ahead = left >= R_GAP * R_GAP and par.jobs() > 1
     if ahead:
         tasks.insert(0, functools.partial(reading, each(FRICTION_LIMIT)))
