@@ -739,8 +739,8 @@ def saturated(v: np.ndarray, level: float) -> np.ndarray:
     count-rate ceiling `level` (`plateau_level`: the top of a flat top whose ticks lie within
     PLATEAU_TOL below it). The ticks scatter about the true ceiling both ways, by whole counts
     and by the stamps, and the level is their top: the ticks within twice PLATEAU_TOL below it
-    are on the ceiling. A tick at most PLATEAU_DIP below it, between ceiling ticks at most
-    PLATEAU_GAP_TICKS apart, is on it too: a wheel does not leave its ceiling and come back
+    are on the ceiling. Ticks at most PLATEAU_DIP below it, at most PLATEAU_GAP_TICKS of them
+    between ceiling ticks, are on it too: a wheel does not leave its ceiling and come back
     within a tick or two; a skipped quadrature state or a long stamp reads a few counts short.
     A set's decoder at 44 kHz counted 1101 or 1102 edges per 25 ms tick through a 3.4 s
     sprint, read as 951.7-957.6 mm/s over the ticks' lengths (the level the top); within
