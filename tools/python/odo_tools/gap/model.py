@@ -645,11 +645,9 @@ def skipped_evidence(prs: list) -> str | None:
     )
 
 
-PLATEAU_TOL = 0.003  # a flat top's ticks lie within 0.3 % below its top (`plateau_level`)
+PLATEAU_TOL = 0.003  # a tick within 0.3 % of the decoder's count-rate ceiling is saturated
 PLATEAU_SUB = 8  # sub-steps per tick of the hidden speed's integral
 PLATEAU_MIN_TICKS = 3  # a ceiling is a flat top: this many ticks of the counts reach it
-PLATEAU_GAP_TICKS = 2  # a flat top goes on across this many ticks that dip below it ...
-PLATEAU_DIP = 0.05  # ... by at most this share of the ceiling (`saturated`)
 
 
 def counted_speed(pr: Prepared, truck: int) -> np.ndarray:
@@ -734,34 +732,6 @@ def count_loss_plateau(pr: Prepared, ds: np.ndarray, truck: int, P: dict) -> np.
     return out
 
 
-def saturated(v: np.ndarray, level: float) -> np.ndarray:
-    """(ticks, wheels) bool: the ticks a wheel's counted speed v spends on the decoder's
-    count-rate ceiling `level` (`plateau_level`: the top of a flat top whose ticks lie within
-    PLATEAU_TOL below it). The ticks scatter about the true ceiling both ways, by whole counts
-    and by the stamps, and the level is their top: the ticks within twice PLATEAU_TOL below it
-    are on the ceiling. Ticks at most PLATEAU_DIP below it, at most PLATEAU_GAP_TICKS of them
-    between ceiling ticks, are on it too: a wheel does not leave its ceiling and come back
-    within a tick or two; a skipped quadrature state or a long stamp reads a few counts short.
-    A set's decoder at 44 kHz counted 1101 or 1102 edges per 25 ms tick through a 3.4 s
-    sprint, read as 951.7-957.6 mm/s over the ticks' lengths (the level the top); within
-    PLATEAU_TOL of it the sprint fell into 46 stretches on one wheel and 41 on the other, each
-    rising afresh from the ceiling at the 50 mm/s^2 floor of its counts' ramp, the law hid
-    nothing, and the held-out sprint stayed 555 mm off ("unexplained" at 49.9 x the background;
-    independent world, dev seed 4532 case 39). Within twice PLATEAU_TOL, six stretches; with
-    the dips, one on each wheel, and the case is count loss."""
-    sat = v >= level * (1.0 - 2.0 * PLATEAU_TOL)
-    near = v >= level * (1.0 - PLATEAU_DIP)
-    out = sat.copy()
-    for w in range(v.shape[1]):
-        on = np.flatnonzero(sat[:, w])
-        gap = np.diff(on)
-        for g in np.flatnonzero((gap > 1) & (gap <= PLATEAU_GAP_TICKS + 1)):
-            a, b = on[g] + 1, on[g + 1]
-            if near[a:b, w].all():
-                out[a:b, w] = True
-    return out
-
-
 RAMP_S = 0.1  # the counts' rise into a ceiling (and fall out of it) is read over this long
 RAMP_MIN_MM_S2 = 50.0  # ... and taken as at least this steep
 
@@ -794,7 +764,7 @@ def _plateau_stretches(pr: Prepared, truck: int, level: float) -> tuple | None:
     if key in pr.slip_cache:
         return pr.slip_cache[key]
     v = counted_speed(pr, truck)
-    sat = saturated(v, level)
+    sat = v >= level * (1.0 - PLATEAU_TOL)
     if not sat.any():  # nothing saturates (and a run of one tick has no median tick to read)
         _cache_put(pr.slip_cache, key, None)
         return None
