@@ -315,6 +315,47 @@ def test_a_rate_ceiling_is_reached_at_the_rate_the_counts_show() -> None:
             assert count_loss_plateau(few, d[:, 0, :].copy(), 0, P).shape == (m, 2)
 
 
+def test_a_rate_ceiling_whose_flat_top_scatters_hides_one_sprint_on_both_wheels() -> None:
+    """model.count_loss_plateau: a straight sprint, both wheels at 1130 mm/s behind a decoder
+    that counts 950, reached at 0.5 m/s^2. Each wheel's flat top scatters up to 0.6 % under
+    its top, tick by tick and wheel by wheel (whole counts and stamps; dev seed 4532 case 39),
+    so only some ticks lie within PLATEAU_TOL of the ceiling. The sprint is one on each wheel,
+    its hidden speed rises from where the counts' ramp crosses the ceiling, and both wheels
+    get back the travel they lost: the robot does not turn where no count says it did."""
+    from odo_tools.gap.model import PLATEAU_TOL, Prepared, count_loss_plateau, plateau_level
+
+    dt, a, vmax, ceil, step = 0.025, 500.0, 1130.0, 950.0, 1e-4
+    fine = np.arange(0.0, 6.0, step)
+    ramp = np.minimum(np.minimum(a * (fine + 1.0), a * (fine[-1] + 1.0 - fine)), vmax)
+    v = np.concatenate([np.zeros(4000), ramp, np.zeros(4000)])
+    per = round(dt / step)
+    v = v[: v.size // per * per]
+    true = v.reshape(-1, per).sum(axis=1) * step
+    counted = np.minimum(v, ceil).reshape(-1, per).sum(axis=1) * step
+    top = counted >= ceil * dt * (1 - 1e-9)
+    rng = np.random.default_rng(3)
+    ds = np.repeat(counted[:, None, None], 2, axis=2)
+    ds[top, 0, :] *= 1.0 - rng.uniform(0.0, 0.006, (int(top.sum()), 2))
+    n = counted.size + 1
+    S = np.concatenate([np.zeros((1, 1, 2)), np.cumsum(np.abs(ds), axis=0)])
+    pr = Prepared(None, np.arange(n) * dt, ds, S, [400.0], [75.0], np.full(n - 1, dt))
+    level = plateau_level([pr])
+    on = ds[:, 0, :] / dt >= level * (1.0 - PLATEAU_TOL)
+    assert 0.2 < on[top].mean() < 0.8  # the flat top falls into many stretches on each wheel
+    assert np.count_nonzero(np.diff(on[:, 0].astype(int)) == 1) > 10
+    P = {
+        "count_loss@plateau.level_mm_s": level,
+        "count_loss@plateau.excess_mm_s": vmax - level,
+        "count_loss@plateau.a_m_s2": a / 1000.0,
+    }
+    got = count_loss_plateau(pr, ds[:, 0, :].copy(), 0, P) - ds[:, 0, :]
+    lost = true.sum() - counted.sum()
+    assert lost > 500.0  # half a metre hidden on each wheel
+    for w in (0, 1):
+        assert got[:, w].sum() == pytest.approx(lost, rel=0.03)
+    assert abs(got[:, 0].sum() - got[:, 1].sum()) < 0.01 * lost  # no turn the counts never made
+
+
 def test_a_rate_ceiling_is_found_under_jittered_stamps() -> None:
     """model.counted_speed: a decoder at its ceiling counts the same per tick; a log stamped on
     arrival jitters the recorded tick lengths (here +-0.7 % on 10 ms) without the counts

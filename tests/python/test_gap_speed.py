@@ -201,15 +201,19 @@ def test_no_drive_effect_is_fitted_on_a_passive_trailer() -> None:
 
 
 def test_rate_ceiling_law_over_every_stretch_at_once_is_the_per_stretch_loop_bit_for_bit() -> None:
-    """model.count_loss_plateau adds the hidden travel of every saturated tick of both wheels
-    in one step (`_plateau_stretches` keeps them as flat arrays); the form it replaced looped
-    over the stretches, one numpy expression each, each stretch's ramps read from its counts
-    (at most the law's a)."""
+    """model.count_loss_plateau adds the hidden travel of every sprint tick of both wheels in
+    one step (`_plateau_stretches` keeps them as flat arrays); written as a loop over the
+    sprints, one numpy expression each: stretches of saturated ticks joined across short dips,
+    each sprint's ramps read from its counts short of the ceiling's edge (at most the law's
+    a), its hidden speed timed from where those ramps cross the ceiling."""
     from odo_tools.gap.model import (
         PLATEAU_SUB,
         PLATEAU_TOL,
+        RAMP_EDGE,
         RAMP_MIN_MM_S2,
         RAMP_S,
+        SPRINT_DIP,
+        SPRINT_GAP_S,
         count_loss_plateau,
         counted_speed,
     )
@@ -223,15 +227,22 @@ def test_rate_ceiling_law_over_every_stretch_at_once_is_the_per_stretch_loop_bit
     v = counted_speed(pr, 0)  # the wheel speed it reads
     tm = pr.t[:-1] + 0.5 * pr.dt
     k = max(1, round(RAMP_S / float(np.median(pr.dt))))
+    gap = max(1, round(SPRINT_GAP_S / float(np.median(pr.dt))))
+    nt = v.shape[0]
 
-    def rate(w: int, near: int, far: int) -> float:  # the counts' ramp into or out of it
-        if not 0 <= near < v.shape[0]:
-            return math.inf
-        far = min(max(far, 0), v.shape[0] - 1)
-        if far == near:
-            return math.inf
-        return max((v[near, w] - v[far, w]) / abs(tm[near] - tm[far]), RAMP_MIN_MM_S2)
+    def ramp(w: int, start: int, step: int, edge_t: float) -> tuple[float, float]:
+        """(rate, time it crosses the ceiling) of the counts' ramp from tick `start` outwards."""
+        j = start
+        while 0 <= j < nt and v[j, w] >= level * (1 - RAMP_EDGE) and abs(j - start) < k:
+            j += step
+        far = min(max(j + step * k, 0), nt - 1)
+        if not 0 <= j < nt or far == j:
+            return math.inf, edge_t
+        r = max((v[j, w] - v[far, w]) / abs(tm[j] - tm[far]), RAMP_MIN_MM_S2)
+        cross = tm[j] - step * (level - v[j, w]) / r
+        return r, (min if step < 0 else max)(cross, edge_t)
 
+    joined = 0
     for E, a in ((0.4 * level, 2.0), (3.0 * level, 0.3)):
         P = {
             "count_loss@plateau.level_mm_s": level,
@@ -242,22 +253,34 @@ def test_rate_ceiling_law_over_every_stretch_at_once_is_the_per_stretch_loop_bit
         sat = v >= level * (1.0 - PLATEAU_TOL)
         f = (np.arange(PLATEAU_SUB) + 0.5) / PLATEAU_SUB
         stretches = 0
-        for w in (0, 1):  # the form it replaced: one stretch at a time
+        for w in (0, 1):  # one sprint at a time
             m = np.concatenate([[False], sat[:, w], [False]]).astype(np.int8)
             up, down = np.flatnonzero(np.diff(m) == 1), np.flatnonzero(np.diff(m) == -1)
+            sprints: list[list[int]] = []
             for i0, i1 in zip(up, down, strict=True):
-                tau = pr.t[i0:i1, None] - pr.t[i0] + f[None, :] * pr.dt[i0:i1, None]
-                T, am = pr.t[i1] - pr.t[i0], a * 1e3
-                r_in, r_out = rate(w, i0 - 1, i0 - 1 - k), rate(w, i1, i1 + k)
+                dip = v[sprints[-1][1] : i0, w] if sprints else None
+                if dip is not None and i0 - sprints[-1][1] <= gap and np.all(
+                    dip >= level * (1 - SPRINT_DIP)
+                ):
+                    sprints[-1][1] = i1
+                    joined += 1
+                else:
+                    sprints.append([i0, i1])
+            for i0, i1 in sprints:
+                ts = pr.t[i0:i1, None] + f[None, :] * pr.dt[i0:i1, None]
+                am = a * 1e3
+                r_in, t_in = ramp(w, i0 - 1, -1, pr.t[i0])
+                r_out, t_out = ramp(w, i1, 1, pr.t[i1])
                 r_in, r_out = (r if math.isinf(r) else min(r, am) for r in (r_in, r_out))
-                ex = np.minimum(np.minimum(r_in * tau, r_out * (T - tau)), E)
+                ex = np.minimum(np.minimum(r_in * (ts - t_in), r_out * (t_out - ts)), E)
                 want[i0:i1, w] += np.sign(ds[i0:i1, w]) * ex.mean(axis=1) * pr.dt[i0:i1]
                 stretches += 1
-        assert stretches > 10  # stretches on both wheels: the comparison covers the flat layout
+        assert stretches > 10  # sprints on both wheels: the comparison covers the flat layout
         got = count_loss_plateau(pr, ds, 0, P)
         assert np.array_equal(got, want), E
         assert not np.array_equal(got, ds)  # the law adds travel: the comparison can fail
         assert np.array_equal(count_loss_plateau(pr, ds, 0, P), got)  # served from the cache
+    assert joined > 0  # some sprint goes on across a dip: the loop covers the joining
 
 
 def test_scrub_factor_column_by_column_is_the_row_reduction_bit_for_bit() -> None:
