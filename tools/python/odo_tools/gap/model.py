@@ -755,26 +755,27 @@ def _ramp_cross(
     hidden speed rises from the time its ramp crosses the ceiling, not from the first tick
     that reaches it. Infinite, and the tick's own time, where the run starts or ends on the
     ceiling (a half cut there: the ramp is not in it)."""
-    n, edge = v.size, level * (1.0 - RAMP_EDGE)
-    j = i0 - 1
-    while j >= 0 and v[j] >= edge and i0 - 1 - j < k:
-        j -= 1
-    far = max(j - k, 0)
-    if j < 0 or far == j:
-        a_in, t_in = math.inf, float(t[i0])
-    else:
-        a_in = max((v[j] - v[far]) / (tm[j] - tm[far]), RAMP_MIN_MM_S2)
-        t_in = min(float(tm[j] + (level - v[j]) / a_in), float(t[i0]))
-    j = i1
-    while j < n and v[j] >= edge and j - i1 < k:
-        j += 1
-    far = min(j + k, n - 1)
-    if j >= n or far == j:
-        a_out, t_out = math.inf, float(t[i1])
-    else:
-        a_out = max((v[j] - v[far]) / (tm[far] - tm[j]), RAMP_MIN_MM_S2)
-        t_out = max(float(tm[j] - (level - v[j]) / a_out), float(t[i1]))
+    a_in, t_in = _ramp(v, tm, i0 - 1, -1, k, level, float(t[i0]))
+    a_out, t_out = _ramp(v, tm, i1, 1, k, level, float(t[i1]))
     return a_in, t_in, a_out, t_out
+
+
+def _ramp(
+    v: np.ndarray, tm: np.ndarray, near: int, step: int, k: int, level: float, bound: float
+) -> tuple[float, float]:
+    """One side of `_ramp_cross`: from tick `near` outwards (step -1 before the sprint, +1
+    after it), past at most k ticks within RAMP_EDGE of the ceiling, the counts' rate over the
+    next k ticks and the time that ramp crosses the ceiling (no later than `bound` before the
+    sprint, no earlier after it); infinite and `bound` where the run ends first."""
+    n, edge, j = v.size, level * (1.0 - RAMP_EDGE), near
+    while 0 <= j < n and v[j] >= edge and abs(j - near) < k:
+        j += step
+    far = min(max(j + step * k, 0), n - 1)
+    if not 0 <= j < n or far == j:
+        return math.inf, bound
+    rate = max((v[j] - v[far]) / abs(tm[j] - tm[far]), RAMP_MIN_MM_S2)
+    cross = float(tm[j] - step * (level - v[j]) / rate)
+    return rate, (min if step < 0 else max)(cross, bound)
 
 
 def _sprints(v: np.ndarray, sat: np.ndarray, level: float, gap: int) -> list[tuple[int, int]]:
@@ -787,14 +788,14 @@ def _sprints(v: np.ndarray, sat: np.ndarray, level: float, gap: int) -> list[tup
     speed does not start again where the counts dip."""
     m = np.concatenate([[False], sat, [False]]).astype(np.int8)
     starts, ends = np.flatnonzero(np.diff(m) == 1), np.flatnonzero(np.diff(m) == -1)
-    out: list[list[int]] = []
+    out: list[tuple[int, int]] = []
     floor = level * (1.0 - SPRINT_DIP)
-    for i0, i1 in zip(starts, ends, strict=True):
+    for i0, i1 in zip(starts.tolist(), ends.tolist(), strict=True):
         if out and i0 - out[-1][1] <= gap and (v[out[-1][1] : i0] >= floor).all():
-            out[-1][1] = int(i1)
+            out[-1] = (out[-1][0], i1)
         else:
-            out.append([int(i0), int(i1)])
-    return [(a, b) for a, b in out]
+            out.append((i0, i1))
+    return out
 
 
 def _plateau_stretches(pr: Prepared, truck: int, level: float) -> tuple | None:
@@ -815,25 +816,25 @@ def _plateau_stretches(pr: Prepared, truck: int, level: float) -> tuple | None:
     t = pr.t
     raw = pr.ds[:, truck, :]
     tm = t[:-1] + 0.5 * pr.dt
-    k = max(1, round(RAMP_S / float(np.median(pr.dt))))
-    gap = max(1, round(SPRINT_GAP_S / float(np.median(pr.dt))))
+    tick = float(np.median(pr.dt))
+    k, gap = max(1, round(RAMP_S / tick)), max(1, round(SPRINT_GAP_S / tick))
     f = (np.arange(PLATEAU_SUB) + 0.5) / PLATEAU_SUB
     parts: list[list[np.ndarray]] = [[] for _ in range(8)]
     for w in (0, 1):
         for i0, i1 in _sprints(v[:, w], sat[:, w], level, gap):
-            idx = np.arange(i0, i1)  # the dips within a sprint as well: the wheel is on it
-            n = idx.size
+            # every tick of the sprint, its dips as well: the wheel is on the ceiling there
+            n = i1 - i0
             a_in, t_in, a_out, t_out = _ramp_cross(v[:, w], tm, t, i0, i1, k, level)
-            ts = t[idx, None] + f[None, :] * pr.dt[idx, None]  # t_in <= t[i0], t_out >= t[i1]
+            ts = t[i0:i1, None] + f[None, :] * pr.dt[i0:i1, None]  # t_in <= t[i0], t_out >= t[i1]
             got = (
-                idx,
+                np.arange(i0, i1),
                 np.full(n, w),
                 ts - t_in,
                 t_out - ts,
                 np.full((n, 1), a_in),
                 np.full((n, 1), a_out),
-                np.sign(raw[idx, w]),
-                pr.dt[idx],
+                np.sign(raw[i0:i1, w]),
+                pr.dt[i0:i1],
             )
             for p, g in zip(parts, got, strict=True):
                 p.append(g)
